@@ -1,0 +1,69 @@
+// The discrete Hamiltonian map (paper, eq. IDEL): (q_k, p_k) -> (q_{k+1}, p_{k+1}), the one-step
+// method that every construction provides, and the bookkeeping shared by all of them: solver
+// options, evaluation counters, Newton statistics, and the numerical failure they raise.
+#pragma once
+
+#include <Eigen/Core>
+#include <stdexcept>
+#include <string>
+
+namespace varia {
+
+struct SolverOptions {
+  double tolerance = 1e-14;  // on the scaled residual or the scaled Newton update
+  int max_iterations = 50;
+};
+
+// Plugin evaluations made so far (the run record's "evaluations").
+struct EvaluationCounters {
+  long lagrangian = 0;
+  long gradient = 0;
+  long hessian = 0;
+};
+
+// Newton statistics of the steps made so far.
+struct SolverStatistics {
+  long solves = 0;
+  long iterations = 0;
+  int max_iterations = 0;
+  void record(int iterations_of_one_solve) {
+    ++solves;
+    iterations += iterations_of_one_solve;
+    if (iterations_of_one_solve > max_iterations) max_iterations = iterations_of_one_solve;
+  }
+  double mean() const { return solves ? static_cast<double>(iterations) / solves : 0.0; }
+};
+
+// A nonlinear solve that did not converge, or a non-finite value. The host adds the step index
+// and time; `residual` is the last residual norm (NaN when not applicable).
+class NumericalFailure : public std::runtime_error {
+ public:
+  NumericalFailure(const std::string& what, double residual)
+      : std::runtime_error(what), residual_(residual) {}
+  double residual() const { return residual_; }
+
+ private:
+  double residual_;
+};
+
+class DiscreteHamiltonianMap {
+ public:
+  virtual ~DiscreteHamiltonianMap() = default;
+  virtual int point_size() const = 0;  // numbers per configuration point
+  virtual int dim() const = 0;         // numbers per momentum
+  // One step of size h from (q0, p0) to (q1, p1). Throws NumericalFailure.
+  virtual void step(const double* q0, const double* p0, double h, double* q1, double* p1) = 0;
+  virtual const SolverStatistics& solver_statistics() const = 0;
+  virtual const EvaluationCounters& evaluations() const = 0;
+};
+
+// A discrete Lagrangian L_d(q0, q1; h) (paper, sec. 1) with its derivatives D1 L_d, D2 L_d (on a
+// Lie group, left-trivialized). Constructions that have one implement both interfaces.
+class DiscreteLagrangian {
+ public:
+  virtual ~DiscreteLagrangian() = default;
+  virtual void evaluate(const double* q0, const double* q1, double h, double* Ld, double* D1,
+                        double* D2) = 0;
+};
+
+}  // namespace varia

@@ -1,0 +1,50 @@
+// Lagrangian L : TQ -> R (paper, sec. 1), evaluated at one point (q, v) per call: q is the
+// manifold point (m = point_size numbers), v the (left-trivialized) velocity (n = dim numbers).
+// The gradient is [dL/dq (m), dL/dv (n)]; on a Lie group dL/dq is the gradient in the embedding.
+#pragma once
+
+#include "varia/core/plugin_object.hpp"
+
+namespace varia {
+
+class Lagrangian : public PluginObject {
+ public:
+  Kind kind() const noexcept final { return Kind::lagrangian; }
+  virtual int position_size() const noexcept = 0;  // m
+  virtual int velocity_size() const noexcept = 0;  // n
+
+  // Any of value, gradient, hessian may be null and is then not computed. The Hessian of
+  // z = (q, v) is written densely, column-major (m+n)^2, unless hessian_pattern() says sparse.
+  virtual Status evaluate(const double* q, const double* v, double* value, double* gradient,
+                          double* hessian) noexcept = 0;
+  // Sparse Hessian: returns the number of stored entries and points rows/cols at their (row, col)
+  // indices (lower and upper triangle both stored); -1 (the default) means dense.
+  virtual int hessian_pattern(const int** /*rows*/, const int** /*cols*/) const noexcept {
+    return -1;
+  }
+  // L = 1/2 v^T M v - V(q) with a constant mass matrix M: fills M (n x n, column-major) and
+  // returns true. The constructions may then use explicit forms of their equations.
+  virtual bool constant_mass_matrix(double* /*mass*/) const noexcept { return false; }
+
+  // The declared symmetry (Noether): a group name ("none", "SO(2)", "SO(3)", ...), the size of
+  // its momentum map J(q, v) = <dL/dv, xi_Q(q)>, and the lifted action of a pseudo-random group
+  // element drawn from `seed` on (q, v), for invariance checks.
+  virtual const char* symmetry_group() const noexcept { return "none"; }
+  virtual int momentum_size() const noexcept { return 0; }
+  virtual Status momentum(const double* /*q*/, const double* /*v*/, double* /*J*/) noexcept {
+    return "this Lagrangian declares no symmetry";
+  }
+  virtual Status act(unsigned /*seed*/, const double* /*q*/, const double* /*v*/, double* /*gq*/,
+                     double* /*gv*/) noexcept {
+    return "this Lagrangian declares no symmetry";
+  }
+
+  // The exact flow (q(t), v(t)) from (q0, v0), where one is known in closed form.
+  virtual bool has_exact_solution() const noexcept { return false; }
+  virtual Status exact_solution(const double* /*q0*/, const double* /*v0*/, double /*t*/,
+                                double* /*q*/, double* /*v*/) noexcept {
+    return "this Lagrangian has no exact solution";
+  }
+};
+
+}  // namespace varia

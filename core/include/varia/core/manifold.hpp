@@ -1,0 +1,25 @@
+// Configuration manifold Q with a natural chart (paper, sec. 2 "Natural charts"):
+// psi_{q0}^{-1}(xi) = q0 exp(xi) (retract) and psi_{q0}(q) = log(q0^{-1} q) (local).
+// A point is point_size() numbers (n on R^n; 9 on SO(3), a row-major rotation matrix); tangent
+// vectors, velocities and momenta are dim() numbers, left-trivialized on a Lie group.
+#pragma once
+
+#include "varia/core/plugin_object.hpp"
+
+namespace varia {
+
+class Manifold : public PluginObject {
+ public:
+  Kind kind() const noexcept final { return Kind::manifold; }
+  virtual int point_size() const noexcept = 0;
+  virtual int dim() const noexcept = 0;
+  // True when the natural chart is affine, q = q0 + xi (a vector space): the constructions then
+  // assemble their equations directly in the coordinates, with the Lagrangian's sparsity.
+  virtual bool is_vector_space() const noexcept = 0;
+  virtual Status retract(const double* q0, const double* xi, double* q) noexcept = 0;
+  virtual Status local(const double* q0, const double* q, double* xi) noexcept = 0;
+  // Checks that q is a point of the manifold (to a tolerance); fills `why` when it is not.
+  virtual bool contains(const double* q, char* why, int why_size) noexcept = 0;
+};
+
+}  // namespace varia

@@ -1,0 +1,49 @@
+// Continuous mechanics of a Lagrangian plugin, as the constructions need it: counted and checked
+// evaluations, the Legendre transform p = dL/dv and its inverse, the energy E = <p, v> - L.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+#include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/lagrangian.hpp"
+
+namespace varia {
+
+// Every call the constructions make into a Lagrangian plugin goes through here: it checks the
+// Status, counts the evaluation, and rejects non-finite results.
+class LagrangianEvaluator {
+ public:
+  explicit LagrangianEvaluator(Lagrangian& lagrangian);
+  Lagrangian& plugin() const { return lagrangian_; }
+  int position_size() const { return m_; }
+  int velocity_size() const { return n_; }
+  double value(const double* q, const double* v);
+  // gradient: m + n numbers [dL/dq, dL/dv].
+  double gradient(const double* q, const double* v, double* gradient);
+  // hessian: (m+n)^2 numbers, dense column-major (sparse Lagrangians are expanded).
+  double hessian(const double* q, const double* v, double* gradient, double* hessian);
+  const EvaluationCounters& counters() const { return counters_; }
+
+  // p = dL/dv (q, v).
+  void legendre(const double* q, const double* v, double* p);
+  // Solves dL/dv (q, v) = p for v by Newton's method from the guess in v (exact Hessian block).
+  void inverse_legendre(const double* q, const double* p, double* v, const SolverOptions& options);
+  // E = <dL/dv, v> - L.
+  double energy(const double* q, const double* v);
+
+ private:
+  void check_finite(const double* values, int count, const char* what) const;
+  Lagrangian& lagrangian_;
+  int m_, n_;
+  const int* pattern_rows_ = nullptr;
+  const int* pattern_cols_ = nullptr;
+  int pattern_size_ = -1;
+  // Workspace, sized once: an evaluation allocates nothing.
+  Eigen::VectorXd sparse_values_, gradient_, residual_, update_;
+  Eigen::MatrixXd hessian_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  EvaluationCounters counters_;
+};
+
+}  // namespace varia

@@ -1,0 +1,220 @@
+#include "varia/core/galerkin.hpp"
+
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace varia {
+
+namespace {
+
+// l_nu(tau) and l'_nu(tau) of the Lagrange basis through the control times d.
+void lagrange(const std::vector<double>& d, double tau, double* l, double* dl) {
+  const int count = static_cast<int>(d.size());
+  for (int nu = 0; nu < count; ++nu) {
+    double value = 1.0, derivative = 0.0;
+    for (int mu = 0; mu < count; ++mu) {
+      if (mu == nu) continue;
+      const double denominator = d[nu] - d[mu];
+      derivative = derivative * (tau - d[mu]) / denominator + value / denominator;
+      value *= (tau - d[mu]) / denominator;
+    }
+    l[nu] = value;
+    if (dl != nullptr) dl[nu] = derivative;
+  }
+}
+
+void check_control_times(const std::vector<double>& d) {
+  if (d.size() < 2) throw std::invalid_argument("a Galerkin interpolant needs degree >= 1");
+  if (d.front() != 0.0 || d.back() != 1.0)
+    throw std::invalid_argument("control times must start at 0 and end at 1");
+  for (std::size_t i = 1; i < d.size(); ++i)
+    if (!(d[i] > d[i - 1])) throw std::invalid_argument("control times must increase");
+}
+
+bool small(double value, double tolerance, double scale) { return value <= tolerance * (1.0 + scale); }
+
+}  // namespace
+
+std::vector<double> equispaced_control_times(int degree) {
+  if (degree < 1) throw std::invalid_argument("a Galerkin interpolant needs degree >= 1");
+  std::vector<double> d(degree + 1);
+  for (int nu = 0; nu <= degree; ++nu) d[nu] = static_cast<double>(nu) / degree;
+  return d;
+}
+
+LagrangeBasis::LagrangeBasis(const std::vector<double>& times, const Quadrature& quadrature)
+    : control_times(times) {
+  check_control_times(times);
+  const int r = quadrature.size(), count = static_cast<int>(times.size());
+  phi.resize(r, count);
+  dphi.resize(r, count);
+  Eigen::VectorXd l(count), dl(count);
+  for (int i = 0; i < r; ++i) {
+    lagrange(times, quadrature.nodes()[i], l.data(), dl.data());
+    phi.row(i) = l;
+    dphi.row(i) = dl;
+  }
+}
+
+Eigen::VectorXd LagrangeBasis::at(double tau) const {
+  Eigen::VectorXd l(control_times.size());
+  lagrange(control_times, tau, l.data(), nullptr);
+  return l;
+}
+
+GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian,
+                                                       Quadrature& quadrature,
+                                                       std::vector<double> control_times,
+                                                       SolverOptions options)
+    : lagrangian_(lagrangian),
+      basis_(control_times, quadrature),
+      weights_(Eigen::Map<const Eigen::VectorXd>(quadrature.weights(), quadrature.size())),
+      options_(options),
+      n_(manifold.dim()),
+      s_(static_cast<int>(control_times.size()) - 1) {
+  if (!manifold.is_vector_space())
+    throw std::invalid_argument("the Galerkin construction needs a natural chart on this manifold");
+  if (lagrangian.position_size() != n_ || lagrangian.velocity_size() != n_)
+    throw std::invalid_argument("the Lagrangian's sizes do not match the manifold's dimension");
+  if (quadrature.derivative_terms() > 0)
+    throw std::invalid_argument(
+        "the Galerkin construction takes quadratures without endpoint derivative terms");
+  extrapolation_.resize(s_ + 1, s_ + 1);
+  for (int nu = 0; nu <= s_; ++nu) extrapolation_.col(nu) = basis_.at(1.0 + control_times[nu]);
+  points_.resize(n_, s_ + 1);
+  previous_.resize(n_, s_ + 1);
+  q_.resize(n_);
+  v_.resize(n_);
+  velocity_ = Eigen::VectorXd::Zero(n_);
+  grad_.resize(2 * n_);
+  hess_.resize(2 * n_, 2 * n_);
+  gradient_.resize((s_ + 1) * n_);
+  hessian_.resize((s_ + 1) * n_, (s_ + 1) * n_);
+  residual_.resize(s_ * n_);
+  update_.resize(s_ * n_);
+  jacobian_.resize(s_ * n_, s_ * n_);
+  lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(s_ * n_);
+  residuals_.reserve(options_.max_iterations + 1);
+}
+
+// S = h sum_i b_i L(q_i, v_i), q_i = sum_nu l_nu(c_i) q^nu, v_i = (1/h) sum_nu l'_nu(c_i) q^nu
+// (paper, sec. 2), and by the chain rule
+//   dS/dq^nu = sum_i b_i (h l_nu L_q + l'_nu L_v),
+//   d2S/dq^nu dq^mu = sum_i b_i (h l_nu l_mu L_qq + l_nu l'_mu L_qv + l'_nu l_mu L_vq
+//                                + l'_nu l'_mu L_vv / h).
+double GalerkinDiscreteLagrangian::action(double h, Order order) {
+  const int n = n_;
+  double S = 0.0;
+  if (order != Order::value) gradient_.setZero();
+  if (order == Order::hessian) hessian_.setZero();
+  for (int i = 0; i < basis_.phi.rows(); ++i) {
+    if (weights_[i] == 0.0) continue;
+    q_.noalias() = points_ * basis_.phi.row(i).transpose();
+    v_.noalias() = points_ * basis_.dphi.row(i).transpose();
+    v_ /= h;
+    double L = 0.0;
+    if (order == Order::hessian)
+      L = lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data());
+    else if (order == Order::gradient)
+      L = lagrangian_.gradient(q_.data(), v_.data(), grad_.data());
+    else
+      L = lagrangian_.value(q_.data(), v_.data());
+    const double b = weights_[i];
+    S += h * b * L;
+    if (order == Order::value) continue;
+    for (int nu = 0; nu <= s_; ++nu) {
+      const double a = basis_.phi(i, nu), da = basis_.dphi(i, nu);
+      gradient_.segment(nu * n, n) += b * (h * a * grad_.head(n) + da * grad_.tail(n));
+      if (order != Order::hessian) continue;
+      for (int mu = 0; mu <= s_; ++mu) {
+        const double c = basis_.phi(i, mu), dc = basis_.dphi(i, mu);
+        hessian_.block(nu * n, mu * n, n, n) +=
+            b * (h * a * c * hess_.topLeftCorner(n, n) + a * dc * hess_.topRightCorner(n, n) +
+                 da * c * hess_.bottomLeftCorner(n, n) + da * dc / h * hess_.bottomRightCorner(n, n));
+      }
+    }
+  }
+  return S;
+}
+
+void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
+                                        int blocks, const double* p0) {
+  const int size = blocks * n_;
+  residuals_.clear();
+  auto residual = residual_.head(size);
+  auto update = update_.head(size);
+  for (int iteration = 0;; ++iteration) {
+    action(h, Order::hessian);
+    residual = gradient_.segment(first_equation * n_, size);
+    double scale = gradient_.lpNorm<Eigen::Infinity>();
+    if (p0 != nullptr) {
+      const Eigen::Map<const Eigen::VectorXd> momentum(p0, n_);
+      residual.head(n_) += momentum;
+      scale = std::max(scale, momentum.lpNorm<Eigen::Infinity>());
+    }
+    const double norm = residual.lpNorm<Eigen::Infinity>();
+    residuals_.push_back(norm);
+    if (!std::isfinite(norm))
+      throw NumericalFailure("the Galerkin equations have a non-finite residual", norm);
+    if (small(norm, options_.tolerance, scale)) return statistics_.record(iteration);
+    if (iteration == options_.max_iterations)
+      throw NumericalFailure("Newton's method did not converge in " +
+                                 std::to_string(options_.max_iterations) + " iterations",
+                             norm);
+    if (size == jacobian_.rows()) {
+      jacobian_ = hessian_.block(first_equation * n_, first_unknown * n_, size, size);
+      lu_.compute(jacobian_);
+      update.noalias() = lu_.solve(residual);
+    } else {
+      update = hessian_.block(first_equation * n_, first_unknown * n_, size, size)
+                   .partialPivLu()
+                   .solve(residual);
+    }
+    points_.middleCols(first_unknown, blocks).reshaped() -= update;
+    if (small(update.lpNorm<Eigen::Infinity>(), options_.tolerance,
+              points_.lpNorm<Eigen::Infinity>())) {
+      action(h, Order::gradient);
+      return statistics_.record(iteration + 1);
+    }
+  }
+}
+
+// The initial guess: the previous step's interpolant continued past its end when this step
+// follows it, otherwise a straight line with the velocity of the inverse Legendre transform.
+void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
+  const Eigen::Map<const Eigen::VectorXd> start(q0, n_);
+  if (has_previous_ && previous_h_ == h && previous_.col(s_) == start) {
+    points_.noalias() = previous_ * extrapolation_;
+  } else {
+    lagrangian_.inverse_legendre(q0, p0, velocity_.data(), options_);
+    for (int nu = 0; nu <= s_; ++nu)
+      points_.col(nu) = start + basis_.control_times[nu] * h * velocity_;
+  }
+  points_.col(0) = start;
+}
+
+void GalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double h, double* q1,
+                                      double* p1) {
+  warm_start(q0, p0, h);
+  newton(h, 1, 0, s_, p0);
+  Eigen::Map<Eigen::VectorXd>(q1, n_) = points_.col(s_);
+  Eigen::Map<Eigen::VectorXd>(p1, n_) = gradient_.segment(s_ * n_, n_);  // p1 = D2 L_d
+  previous_ = points_;
+  previous_h_ = h;
+  has_previous_ = true;
+}
+
+void GalerkinDiscreteLagrangian::evaluate(const double* q0, const double* q1, double h, double* Ld,
+                                          double* D1, double* D2) {
+  const Eigen::Map<const Eigen::VectorXd> a(q0, n_), b(q1, n_);
+  for (int nu = 0; nu <= s_; ++nu)
+    points_.col(nu) = a + basis_.control_times[nu] * (b - a);
+  if (s_ > 1) newton(h, 1, 1, s_ - 1, nullptr);
+  const double S = action(h, Order::gradient);
+  if (Ld != nullptr) *Ld = S;
+  if (D1 != nullptr) Eigen::Map<Eigen::VectorXd>(D1, n_) = gradient_.head(n_);
+  if (D2 != nullptr) Eigen::Map<Eigen::VectorXd>(D2, n_) = gradient_.segment(s_ * n_, n_);
+}
+
+}  // namespace varia

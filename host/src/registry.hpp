@@ -1,0 +1,80 @@
+// The plugin registry (spec: "Build layout"). Candidates are the *.so files of the bundled
+// directory, of every --plugin-path and of VARIA_PLUGIN_PATH. A candidate's symbol table is read
+// without loading it (boost::dll::library_info) to learn which kind and type it provides
+// (the varia_type_<kind>__<type> marker), so that a run loads only the files its scene names.
+// Loading checks varia_abi_version before importing anything else. Objects a plugin makes hold a
+// reference to its shared_library, so a library never unloads under a live object.
+#pragma once
+
+#include <boost/dll/shared_library.hpp>
+#include <filesystem>
+#include <map>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "varia/core/plugin_object.hpp"
+#include "varia/sdk/plugin.hpp"
+
+namespace varia::host {
+
+// Bad input (exit code 2): the message names what was wrong and what was expected.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A plugin that cannot be loaded or misbehaves (exit code 3): the message names the file.
+// (varia::PluginFault from core is the same exit code.)
+class PluginLoadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct PluginRecord {
+  std::filesystem::path file;
+  std::string kind, type, version;
+  nlohmann::json parameter_schema, properties;
+};
+
+struct Refusal {
+  std::filesystem::path file;
+  std::string reason;
+};
+
+class Registry {
+ public:
+  // The directories searched, in order: the bundled plugins (found relative to the running
+  // executable), each of `plugin_paths`, then VARIA_PLUGIN_PATH (colon-separated).
+  static std::vector<std::filesystem::path> search_path(const std::vector<std::string>& plugin_paths);
+  explicit Registry(std::vector<std::filesystem::path> directories);
+
+  // Every plugin found, loading every candidate; the refused files with their reasons.
+  std::vector<PluginRecord> list(std::vector<Refusal>& refused);
+  // The plugin of this kind and type, loading only the candidate files that declare it. Throws
+  // InputError for an unknown type (listing the valid ones), PluginLoadError for a bad file,
+  // and PluginLoadError naming both files for a duplicate type name.
+  const PluginRecord& find(const std::string& kind, const std::string& type);
+  // Constructs an object of a plugin found with find(); parameters are those of the scene's
+  // object (its "type" key removed), already validated against the plugin's schema.
+  std::shared_ptr<PluginObject> create(const std::string& kind, const std::string& type,
+                                       const nlohmann::json& parameters,
+                                       const sdk::Context& context);
+  template <class T>
+  std::shared_ptr<T> create_as(const std::string& kind, const std::string& type,
+                               const nlohmann::json& parameters, const sdk::Context& context) {
+    return std::static_pointer_cast<T>(create(kind, type, parameters, context));
+  }
+  // Type names of the plugins loaded so far, in load order (the run record's plugins_loaded).
+  std::vector<std::string> loaded() const;
+
+ private:
+  struct Loaded;
+  std::vector<std::filesystem::path> directories_;
+  std::map<std::string, std::shared_ptr<Loaded>> loaded_;  // key: kind + "/" + type
+  std::vector<std::string> load_order_;
+};
+
+}  // namespace varia::host

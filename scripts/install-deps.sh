@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Installs varia's build dependencies from Debian 12's packages. Idempotent: packages already
+# present are left alone, and apt-get is not called at all when nothing is missing.
+set -euo pipefail
+packages=(
+  build-essential cmake ninja-build pkg-config
+  libeigen3-dev libboost-dev nlohmann-json3-dev libfmt-dev doctest-dev libcli11-dev
+  libvalijson-dev gnuplot-nox
+)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+if ((${#missing[@]})); then
+  sudo_cmd=()
+  [ "$(id -u)" -eq 0 ] || sudo_cmd=(sudo)
+  echo "installing: ${missing[*]}" >&2
+  "${sudo_cmd[@]}" apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive "${sudo_cmd[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}"
+fi

@@ -1,0 +1,96 @@
+// A Lagrangian written once, templated on its scalar, with exact derivatives by forward-mode
+// automatic differentiation (Eigen's AutoDiffScalar; nested once for the Hessian). The model
+// class derives from AutodiffLagrangian<Model> and defines
+//
+//   template <class T> T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const;
+//
+// Derivative vectors have a fixed capacity, so an evaluation allocates nothing.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <unsupported/Eigen/AutoDiff>
+
+#include "varia/core/lagrangian.hpp"
+#include "varia/sdk/plugin.hpp"
+
+namespace varia::sdk {
+
+inline constexpr int kMaxAutodiffVariables = 16;  // m + n of an autodiff Lagrangian
+template <class T>
+using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, kMaxAutodiffVariables, 1>;
+using Dual = Eigen::AutoDiffScalar<Vec<double>>;
+using Dual2 = Eigen::AutoDiffScalar<Vec<Dual>>;
+
+template <class Model>
+class AutodiffLagrangian : public Lagrangian {
+ public:
+  AutodiffLagrangian(int position_size, int velocity_size) : m_(position_size), n_(velocity_size) {
+    if (m_ + n_ > kMaxAutodiffVariables)
+      throw std::invalid_argument("an autodiff Lagrangian takes at most " +
+                                  std::to_string(kMaxAutodiffVariables) +
+                                  " position and velocity numbers together");
+  }
+  int position_size() const noexcept final { return m_; }
+  int velocity_size() const noexcept final { return n_; }
+
+  Status evaluate(const double* q, const double* v, double* value, double* gradient,
+                  double* hessian) noexcept final {
+    return guarded(error_, [&] {
+      if (hessian != nullptr)
+        second_order(q, v, value, gradient, hessian);
+      else if (gradient != nullptr)
+        first_order(q, v, value, gradient);
+      else if (value != nullptr)
+        *value = model().lagrangian(Vec<double>(Eigen::Map<const Vec<double>>(q, m_)),
+                                    Vec<double>(Eigen::Map<const Vec<double>>(v, n_)));
+    });
+  }
+
+ protected:
+  std::string error_;  // the message of the last failed call (see guarded)
+
+ private:
+  const Model& model() const { return static_cast<const Model&>(*this); }
+  double at(const double* q, const double* v, int k) const { return k < m_ ? q[k] : v[k - m_]; }
+
+  void first_order(const double* q, const double* v, double* value, double* gradient) const {
+    const int k = m_ + n_;
+    Vec<Dual> qd(m_), vd(n_);
+    for (int i = 0; i < k; ++i) {
+      Dual z(at(q, v, i), k, i);
+      (i < m_ ? qd(i) : vd(i - m_)) = z;
+    }
+    const Dual r = model().lagrangian(qd, vd);
+    if (value != nullptr) *value = r.value();
+    for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : 0.0;
+  }
+
+  void second_order(const double* q, const double* v, double* value, double* gradient,
+                    double* hessian) const {
+    const int k = m_ + n_;
+    Vec<Dual2> qd(m_), vd(n_);
+    for (int i = 0; i < k; ++i) {
+      Dual2 z;
+      z.value() = Dual(at(q, v, i), k, i);
+      z.derivatives().resize(k);
+      for (int j = 0; j < k; ++j) z.derivatives()(j) = Dual(i == j ? 1.0 : 0.0, Vec<double>::Zero(k));
+      (i < m_ ? qd(i) : vd(i - m_)) = z;
+    }
+    const Dual2 r = model().lagrangian(qd, vd);
+    if (value != nullptr) *value = r.value().value();
+    const bool has_first = r.value().derivatives().size() == k;
+    const bool has_second = r.derivatives().size() == k;
+    for (int i = 0; i < k; ++i) {
+      if (gradient != nullptr) gradient[i] = has_first ? r.value().derivatives()(i) : 0.0;
+      for (int j = 0; j < k; ++j) {
+        const auto& dj = has_second ? r.derivatives()(j).derivatives() : Vec<double>();
+        hessian[j * k + i] = dj.size() == k ? dj(i) : 0.0;
+      }
+    }
+  }
+
+  int m_, n_;
+};
+
+}  // namespace varia::sdk

@@ -1,0 +1,64 @@
+// Small in-process models for testing core/ without loading plugins.
+#pragma once
+
+#include <cmath>
+#include <vector>
+
+#include "varia/core/manifold.hpp"
+#include "varia/core/quadrature.hpp"
+#include "varia/sdk/autodiff_lagrangian.hpp"
+
+namespace varia::testing {
+
+struct FlatSpace : Manifold {
+  explicit FlatSpace(int n) : n(n) {}
+  int point_size() const noexcept override { return n; }
+  int dim() const noexcept override { return n; }
+  bool is_vector_space() const noexcept override { return true; }
+  Status retract(const double* q0, const double* xi, double* q) noexcept override {
+    for (int i = 0; i < n; ++i) q[i] = q0[i] + xi[i];
+    return nullptr;
+  }
+  Status local(const double* q0, const double* q, double* xi) noexcept override {
+    for (int i = 0; i < n; ++i) xi[i] = q[i] - q0[i];
+    return nullptr;
+  }
+  bool contains(const double*, char*, int) noexcept override { return true; }
+  int n;
+};
+
+// A fixed rule given by its nodes and weights on [0, 1].
+struct FixedRule : Quadrature {
+  FixedRule(std::vector<double> c, std::vector<double> b, int degree)
+      : c(std::move(c)), b(std::move(b)), exact_degree(degree) {}
+  int size() const noexcept override { return static_cast<int>(c.size()); }
+  const double* nodes() const noexcept override { return c.data(); }
+  const double* weights() const noexcept override { return b.data(); }
+  int degree() const noexcept override { return exact_degree; }
+  bool symmetric() const noexcept override { return true; }
+  std::vector<double> c, b;
+  int exact_degree;
+};
+
+inline FixedRule trapezoid() { return FixedRule({0.0, 1.0}, {0.5, 0.5}, 1); }
+inline FixedRule lobatto3() { return FixedRule({0.0, 0.5, 1.0}, {1.0 / 6, 4.0 / 6, 1.0 / 6}, 3); }
+
+// L = v^2/2 - q^2/2 (unit oscillator) or v^2/2 + cos q (unit pendulum) on R^1.
+struct Oscillator : sdk::AutodiffLagrangian<Oscillator> {
+  Oscillator() : sdk::AutodiffLagrangian<Oscillator>(1, 1) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    return 0.5 * v(0) * v(0) - 0.5 * q(0) * q(0);
+  }
+};
+
+struct Pendulum : sdk::AutodiffLagrangian<Pendulum> {
+  Pendulum() : sdk::AutodiffLagrangian<Pendulum>(1, 1) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::cos;
+    return 0.5 * v(0) * v(0) + cos(q(0));
+  }
+};
+
+}  // namespace varia::testing

@@ -1,0 +1,83 @@
+#include "varia/core/galerkin.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "core/fixtures.hpp"
+
+using namespace varia;
+using namespace varia::testing;
+
+TEST_CASE("galerkin degree 1 with the trapezoid rule is Stormer-Verlet") {
+  FlatSpace space(1);
+  Pendulum pendulum;
+  auto rule = trapezoid();
+  GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(1), {});
+  const double h = 0.1;
+  double q = 1.3, p = 0.0;  // velocity Verlet in (q, p), force -sin q
+  double gq = q, gp = p;
+  for (int k = 0; k < 200; ++k) {
+    const double half = p - 0.5 * h * std::sin(q);
+    q += h * half;
+    p = half - 0.5 * h * std::sin(q);
+    double q1, p1;
+    galerkin.step(&gq, &gp, h, &q1, &p1);
+    gq = q1;
+    gp = p1;
+  }
+  CAPTURE(q - gq);
+  CHECK(std::abs(q - gq) < 1e-13);
+  CHECK(std::abs(p - gp) < 1e-13);
+}
+
+TEST_CASE("galerkin Newton converges quadratically from a cold start") {
+  FlatSpace space(1);
+  Pendulum pendulum;
+  auto rule = lobatto3();
+  GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(2), {});
+  double q0 = 2.0, p0 = 0.5, q1, p1;
+  galerkin.step(&q0, &p0, 0.5, &q1, &p1);
+  const auto& r = galerkin.last_residuals();
+  REQUIRE(r.size() >= 3);
+  // Each residual well above round-off is at most C times the square of the one before.
+  for (std::size_t k = 1; k + 1 < r.size(); ++k) {
+    CAPTURE(k);
+    CAPTURE(r[k - 1]);
+    CAPTURE(r[k]);
+    if (r[k] > 1e-12) CHECK(r[k] <= 10.0 * r[k - 1] * r[k - 1]);
+  }
+  CHECK(galerkin.solver_statistics().max_iterations <= 6);
+}
+
+TEST_CASE("galerkin D1 and D2 are the derivatives of L_d") {
+  FlatSpace space(1);
+  Pendulum pendulum;
+  auto rule = lobatto3();
+  GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(2), {});
+  const double q0 = 0.3, q1 = 0.45, h = 0.2, e = 1e-5;
+  double Ld, D1, D2, plus, minus;
+  galerkin.evaluate(&q0, &q1, h, &Ld, &D1, &D2);
+  // Test-only central differences of L_d in q0 and q1, an independent check of the envelope
+  // argument D_k L_d = dS/dq^k at the extremum.
+  double a = q0 + e, b = q0 - e;
+  galerkin.evaluate(&a, &q1, h, &plus, nullptr, nullptr);
+  galerkin.evaluate(&b, &q1, h, &minus, nullptr, nullptr);
+  CHECK(D1 == doctest::Approx((plus - minus) / (2 * e)).epsilon(1e-8));
+  a = q1 + e;
+  b = q1 - e;
+  galerkin.evaluate(&q0, &a, h, &plus, nullptr, nullptr);
+  galerkin.evaluate(&q0, &b, h, &minus, nullptr, nullptr);
+  CHECK(D2 == doctest::Approx((plus - minus) / (2 * e)).epsilon(1e-8));
+}
+
+TEST_CASE("galerkin non-convergence raises a numerical failure with the residual") {
+  FlatSpace space(1);
+  Pendulum pendulum;
+  auto rule = lobatto3();
+  SolverOptions options;
+  options.max_iterations = 1;
+  GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(2), options);
+  double q0 = 2.0, p0 = 0.5, q1, p1;
+  CHECK_THROWS_AS(galerkin.step(&q0, &p0, 0.5, &q1, &p1), NumericalFailure);
+}
