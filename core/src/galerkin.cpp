@@ -96,6 +96,50 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   jacobian_.resize(s_ * n_, s_ * n_);
   lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(s_ * n_);
   residuals_.reserve(options_.max_iterations + 1);
+  explicit_ = explicit_form_applies(quadrature);
+}
+
+bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
+  mass_matrix_.resize(n_, n_);
+  if (s_ != 1 || !lagrangian_.plugin().constant_mass_matrix(mass_matrix_.data())) return false;
+  for (int i = 0; i < quadrature.size(); ++i) {
+    const double c = quadrature.nodes()[i], b = quadrature.weights()[i];
+    if (b == 0.0) continue;
+    if (c == 0.0)
+      b0_ += b;
+    else if (c == 1.0)
+      b1_ += b;
+    else
+      return false;
+  }
+  mass_.compute(mass_matrix_);
+  if (mass_.info() != Eigen::Success) return false;
+  force_.resize(n_);
+  last_q_.resize(n_);
+  return true;
+}
+
+// L_d = h (b0 L(q0, v) + b1 L(q1, v)), v = (q1 - q0)/h, L = v.Mv/2 - V(q), b0 + b1 = 1:
+//   p0 = -D1 L_d = M v - h b0 dL/dq(q0)  =>  v = M^{-1} (p0 + h b0 dL/dq(q0)), q1 = q0 + h v,
+//   p1 =  D2 L_d = M v + h b1 dL/dq(q1).
+void GalerkinDiscreteLagrangian::explicit_step(const double* q0, const double* p0, double h,
+                                               double* q1, double* p1) {
+  const Eigen::Map<const Eigen::VectorXd> start(q0, n_), momentum(p0, n_);
+  if (!has_force_ || last_q_ != start) {
+    lagrangian_.gradient(q0, v_.data(), grad_.data());  // dL/dq does not depend on v here
+    force_ = grad_.head(n_);
+  }
+  v_ = momentum + h * b0_ * force_;
+  mass_.solveInPlace(v_);
+  Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);
+  end = start + h * v_;
+  lagrangian_.gradient(q1, v_.data(), grad_.data());
+  force_ = grad_.head(n_);
+  last_q_ = end;
+  has_force_ = true;
+  momentum1.noalias() = mass_matrix_ * v_;
+  momentum1 += h * b1_ * force_;
+  statistics_.record(0);
 }
 
 // S = h sum_i b_i L(q_i, v_i), q_i = sum_nu l_nu(c_i) q^nu, v_i = (1/h) sum_nu l'_nu(c_i) q^nu
@@ -196,6 +240,7 @@ void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, 
 
 void GalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double h, double* q1,
                                       double* p1) {
+  if (explicit_) return explicit_step(q0, p0, h, q1, p1);
   warm_start(q0, p0, h);
   newton(h, 1, 0, s_, p0);
   Eigen::Map<Eigen::VectorXd>(q1, n_) = points_.col(s_);

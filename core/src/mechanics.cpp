@@ -59,6 +59,14 @@ double LagrangianEvaluator::hessian(const double* q, const double* v, double* gr
   return L;
 }
 
+void LagrangianEvaluator::gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) {
+  check(lagrangian_.gradient_jet(q, v, value, gradient), "Lagrangian gradient at jets");
+  ++counters_.hessian;
+  bool finite = value == nullptr || isfinite(*value);
+  for (int i = 0; i < m_ + n_; ++i) finite = finite && isfinite(gradient[i]);
+  if (!finite) throw NumericalFailure("the Lagrangian's gradient at jets is not finite", std::nan(""));
+}
+
 void LagrangianEvaluator::legendre(const double* q, const double* v, double* p) {
   gradient(q, v, gradient_.data());
   Eigen::Map<Eigen::VectorXd>(p, n_) = gradient_.tail(n_);

@@ -62,3 +62,15 @@ struct Pendulum : sdk::AutodiffLagrangian<Pendulum> {
 };
 
 }  // namespace varia::testing
+
+namespace varia::testing {
+
+// The unit pendulum declaring its constant mass matrix, which enables explicit forms.
+struct SeparablePendulum : Pendulum {
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    mass[0] = 1.0;
+    return true;
+  }
+};
+
+}  // namespace varia::testing

@@ -81,3 +81,26 @@ TEST_CASE("galerkin non-convergence raises a numerical failure with the residual
   double q0 = 2.0, p0 = 0.5, q1, p1;
   CHECK_THROWS_AS(galerkin.step(&q0, &p0, 0.5, &q1, &p1), NumericalFailure);
 }
+
+TEST_CASE("galerkin explicit form for a constant mass matrix agrees with the Newton solve") {
+  FlatSpace space(1);
+  Pendulum implicit_pendulum;
+  SeparablePendulum explicit_pendulum;
+  auto rule = trapezoid();
+  GalerkinDiscreteLagrangian newton(space, implicit_pendulum, rule, equispaced_control_times(1), {});
+  GalerkinDiscreteLagrangian direct(space, explicit_pendulum, rule, equispaced_control_times(1), {});
+  double a[2] = {1.3, 0.0}, b[2] = {1.3, 0.0}, next[2];
+  for (int k = 0; k < 1000; ++k) {
+    newton.step(&a[0], &a[1], 0.1, &next[0], &next[1]);
+    std::copy(next, next + 2, a);
+    direct.step(&b[0], &b[1], 0.1, &next[0], &next[1]);
+    std::copy(next, next + 2, b);
+  }
+  CHECK(std::abs(a[0] - b[0]) < 1e-12);
+  CHECK(std::abs(a[1] - b[1]) < 1e-12);
+  CHECK(direct.solver_statistics().max_iterations == 0);
+  // One gradient evaluation per step (plus the first), no Hessians.
+  CHECK(direct.evaluations().gradient == 1001);
+  CHECK(direct.evaluations().hessian == 0);
+  CHECK(newton.solver_statistics().max_iterations >= 1);
+}

@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/Cholesky>
 #include <Eigen/LU>
 #include <vector>
 
@@ -60,6 +61,10 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // null) is added to the equation nu = 0 (IDEL: p0 + D1 L_d = 0).
   void newton(double h, int first_unknown, int first_equation, int blocks, const double* p0);
   void warm_start(const double* q0, const double* p0, double h);
+  // Degree 1 with nodes only at 0 and 1 and a constant mass matrix M: the IDEL equations are
+  // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton.
+  bool explicit_form_applies(Quadrature& quadrature);
+  void explicit_step(const double* q0, const double* p0, double h, double* q1, double* p1);
 
   LagrangianEvaluator lagrangian_;
   LagrangeBasis basis_;
@@ -77,6 +82,14 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::MatrixXd hess_, hessian_, jacobian_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   std::vector<double> residuals_;
+  // The explicit form: endpoint weights, the factorized mass matrix, and dL/dq at the last q1
+  // (reused as dL/dq at the next q0: one gradient evaluation per step).
+  bool explicit_ = false;
+  double b0_ = 0.0, b1_ = 0.0;
+  Eigen::MatrixXd mass_matrix_;
+  Eigen::LLT<Eigen::MatrixXd> mass_;
+  Eigen::VectorXd force_, last_q_;
+  bool has_force_ = false;
 };
 
 }  // namespace varia

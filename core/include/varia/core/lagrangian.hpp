@@ -3,6 +3,7 @@
 // The gradient is [dL/dq (m), dL/dv (n)]; on a Lie group dL/dq is the gradient in the embedding.
 #pragma once
 
+#include "varia/core/jet.hpp"
 #include "varia/core/plugin_object.hpp"
 
 namespace varia {
@@ -25,6 +26,14 @@ class Lagrangian : public PluginObject {
   // L = 1/2 v^T M v - V(q) with a constant mass matrix M: fills M (n x n, column-major) and
   // returns true. The constructions may then use explicit forms of their equations.
   virtual bool constant_mass_matrix(double* /*mass*/) const noexcept { return false; }
+  // L and its gradient [dL/dq, dL/dv] at jet inputs (q, v): the jets of L(q(x), v(x)) and of its
+  // gradient for the jet variables x (value may be null). The shooting construction integrates
+  // the Euler-Lagrange vector field at jets with it (paper, sec. 3). The SDK's
+  // AutodiffLagrangian implements it for every model.
+  virtual Status gradient_jet(const Jet2* /*q*/, const Jet2* /*v*/, Jet2* /*value*/,
+                              Jet2* /*gradient*/) noexcept {
+    return "this Lagrangian does not evaluate at jets (derive it from sdk::AutodiffLagrangian)";
+  }
 
   // The declared symmetry (Noether): a group name ("none", "SO(2)", "SO(3)", ...), the size of
   // its momentum map J(q, v) = <dL/dv, xi_Q(q)>, and the lifted action of a pseudo-random group

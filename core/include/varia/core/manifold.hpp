@@ -20,6 +20,9 @@ class Manifold : public PluginObject {
   virtual Status local(const double* q0, const double* q, double* xi) noexcept = 0;
   // Checks that q is a point of the manifold (to a tolerance); fills `why` when it is not.
   virtual bool contains(const double* q, char* why, int why_size) noexcept = 0;
+  // How far q lies off the manifold in its embedding, for the run's drift observables:
+  // ||I - R^T R||_F on SO(3) (the paper's orthogonality error); 0 where every point is valid.
+  virtual double constraint_error(const double* /*q*/) const noexcept { return 0.0; }
 };
 
 }  // namespace varia

@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/jet.hpp"
 #include "varia/core/lagrangian.hpp"
 
 namespace varia {
@@ -23,6 +24,9 @@ class LagrangianEvaluator {
   double gradient(const double* q, const double* v, double* gradient);
   // hessian: (m+n)^2 numbers, dense column-major (sparse Lagrangians are expanded).
   double hessian(const double* q, const double* v, double* gradient, double* hessian);
+  // L (if value is not null) and its m + n gradient numbers at jet inputs. Counted as a Hessian
+  // evaluation: it carries second-order information.
+  void gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient);
   const EvaluationCounters& counters() const { return counters_; }
 
   // p = dL/dv (q, v).

@@ -1,0 +1,163 @@
+// A second-order jet: the value, gradient and Hessian of a quantity as a function of at most
+// kMaxJetVariables independent variables, carried through arithmetic by the chain rule. The
+// shooting construction (paper, sec. 3) propagates jets in (q0, v0) through the one-step method,
+// so that the action S and the end point q^n come out with the first derivatives that D1 L_d and
+// D2 L_d need and the second derivatives that the exact Newton Jacobian of the shooting solve
+// needs. Derivative storage has a fixed capacity: jet arithmetic allocates nothing.
+//
+// A jet with an empty gradient is a constant (its derivatives are zero); arithmetic mixes
+// constants and variables freely, and doubles convert to constants implicitly.
+#pragma once
+
+#include <Eigen/Core>
+#include <cassert>
+#include <cmath>
+#include <compare>
+
+namespace varia {
+
+inline constexpr int kMaxJetVariables = 8;
+
+struct Jet2 {
+  using Gradient = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJetVariables, 1>;
+  using Hessian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJetVariables,
+                                kMaxJetVariables>;
+
+  Jet2() = default;
+  Jet2(double constant) : value(constant) {}  // NOLINT: constants convert implicitly
+  // The independent variable `index` of `count`, at `x`.
+  static Jet2 variable(double x, int count, int index) {
+    Jet2 jet(x);
+    jet.gradient = Gradient::Unit(count, index);
+    jet.hessian = Hessian::Zero(count, count);
+    return jet;
+  }
+  bool constant() const { return gradient.size() == 0; }
+
+  double value = 0.0;
+  Gradient gradient;
+  Hessian hessian;
+};
+
+namespace jet {
+
+// f(a), given f(a.value) and f', f'' there: g = f' a_g, H = f' a_H + f'' a_g a_g^T.
+inline Jet2 unary(const Jet2& a, double f, double d1, double d2) {
+  Jet2 r(f);
+  if (a.constant()) return r;
+  r.gradient = d1 * a.gradient;
+  r.hessian = d1 * a.hessian;
+  if (d2 != 0.0) r.hessian.noalias() += d2 * a.gradient * a.gradient.transpose();
+  return r;
+}
+
+// The partial derivatives of F(a, b) at the values.
+struct Partials {
+  double a, b, aa, ab, bb;
+};
+
+// F(a, b) by the second-order chain rule:
+// g = F_a a_g + F_b b_g,
+// H = F_a a_H + F_b b_H + F_aa a_g a_g^T + F_ab (a_g b_g^T + b_g a_g^T) + F_bb b_g b_g^T.
+inline Jet2 binary(const Jet2& a, const Jet2& b, double f, const Partials& d) {
+  if (a.constant()) return unary(b, f, d.b, d.bb);
+  if (b.constant()) return unary(a, f, d.a, d.aa);
+  assert(a.gradient.size() == b.gradient.size());
+  Jet2 r(f);
+  r.gradient = d.a * a.gradient + d.b * b.gradient;
+  r.hessian = d.a * a.hessian + d.b * b.hessian;
+  if (d.aa != 0.0) r.hessian.noalias() += d.aa * a.gradient * a.gradient.transpose();
+  if (d.bb != 0.0) r.hessian.noalias() += d.bb * b.gradient * b.gradient.transpose();
+  if (d.ab != 0.0) {
+    r.hessian.noalias() += d.ab * a.gradient * b.gradient.transpose();
+    r.hessian.noalias() += d.ab * b.gradient * a.gradient.transpose();
+  }
+  return r;
+}
+
+}  // namespace jet
+
+inline Jet2 operator+(const Jet2& a, const Jet2& b) {
+  return jet::binary(a, b, a.value + b.value, {1, 1, 0, 0, 0});
+}
+inline Jet2 operator-(const Jet2& a, const Jet2& b) {
+  return jet::binary(a, b, a.value - b.value, {1, -1, 0, 0, 0});
+}
+inline Jet2 operator*(const Jet2& a, const Jet2& b) {
+  return jet::binary(a, b, a.value * b.value, {b.value, a.value, 0, 1, 0});
+}
+inline Jet2 operator/(const Jet2& a, const Jet2& b) {
+  const double r = 1.0 / b.value, f = a.value * r;
+  return jet::binary(a, b, f, {r, -f * r, 0, -r * r, 2 * f * r * r});
+}
+inline Jet2 operator-(const Jet2& a) { return jet::unary(a, -a.value, -1, 0); }
+inline Jet2 operator+(const Jet2& a) { return a; }
+inline Jet2& operator+=(Jet2& a, const Jet2& b) { return a = a + b; }
+inline Jet2& operator-=(Jet2& a, const Jet2& b) { return a = a - b; }
+inline Jet2& operator*=(Jet2& a, const Jet2& b) { return a = a * b; }
+inline Jet2& operator/=(Jet2& a, const Jet2& b) { return a = a / b; }
+// Comparisons see the values only (branches in a model pick a smooth piece).
+inline bool operator==(const Jet2& a, const Jet2& b) { return a.value == b.value; }
+inline std::partial_ordering operator<=>(const Jet2& a, const Jet2& b) {
+  return a.value <=> b.value;
+}
+
+inline Jet2 sin(const Jet2& a) {
+  const double s = std::sin(a.value);
+  return jet::unary(a, s, std::cos(a.value), -s);
+}
+inline Jet2 cos(const Jet2& a) {
+  const double c = std::cos(a.value);
+  return jet::unary(a, c, -std::sin(a.value), -c);
+}
+inline Jet2 exp(const Jet2& a) {
+  const double e = std::exp(a.value);
+  return jet::unary(a, e, e, e);
+}
+inline Jet2 log(const Jet2& a) {
+  return jet::unary(a, std::log(a.value), 1 / a.value, -1 / (a.value * a.value));
+}
+inline Jet2 sqrt(const Jet2& a) {
+  const double s = std::sqrt(a.value);
+  return jet::unary(a, s, 0.5 / s, -0.25 / (s * a.value));
+}
+inline Jet2 abs(const Jet2& a) { return a.value < 0 ? -a : a; }
+// a^b; with a constant exponent only the a-derivatives enter (a may then be negative).
+inline Jet2 pow(const Jet2& a, const Jet2& b) {
+  const double f = std::pow(a.value, b.value);
+  const double fa = b.value * std::pow(a.value, b.value - 1);
+  const double faa = b.value * (b.value - 1) * std::pow(a.value, b.value - 2);
+  if (b.constant()) return jet::unary(a, f, fa, faa);
+  const double l = std::log(a.value);
+  return jet::binary(a, b, f, {fa, f * l, faa, fa * l + f / a.value, f * l * l});
+}
+inline bool isfinite(const Jet2& a) {
+  return std::isfinite(a.value) && a.gradient.allFinite() && a.hessian.allFinite();
+}
+
+}  // namespace varia
+
+namespace Eigen {
+
+// Jets are real scalars for Eigen (as its own AutoDiffScalar is): Real is the jet itself, so that
+// norms and dot products of jet vectors stay jets, and a double converts to a constant jet.
+template <>
+struct NumTraits<varia::Jet2> : GenericNumTraits<double> {
+  using Real = varia::Jet2;
+  using NonInteger = varia::Jet2;
+  using Nested = varia::Jet2;
+  using Literal = double;
+  enum { IsComplex = 0, IsInteger = 0, IsSigned = 1, RequireInitialization = 1, ReadCost = 1,
+         AddCost = 3, MulCost = 3 };
+};
+
+template <typename BinaryOp>
+struct ScalarBinaryOpTraits<varia::Jet2, double, BinaryOp> {
+  using ReturnType = varia::Jet2;
+};
+template <typename BinaryOp>
+struct ScalarBinaryOpTraits<double, varia::Jet2, BinaryOp> {
+  using ReturnType = varia::Jet2;
+};
+
+}  // namespace Eigen

@@ -1,0 +1,70 @@
+// The vector field that a one-step method integrates for the shooting construction (paper,
+// sec. 3), for a Lagrangian L = 1/2 v^T M v - V(q) with a constant mass matrix M on R^n:
+//   tangent form (q, v):    q' = v,        v' = M^{-1} dL/dq (q, v)   (Euler-Lagrange),
+//   cotangent form (q, p):  q' = M^{-1} p, p' = dL/dq (q, M^{-1} p)   (Hamilton's equations of
+//                           the Legendre transform H(q, p) = <p, v> - L(q, v), v = M^{-1} p,
+//                           paper, sec. 3 "Generalizations").
+// The acceleration comes from L's exact derivatives, at doubles and at jets. The field also
+// drives one step of a one-step plugin, turning its Status into the right exception.
+#pragma once
+
+#include <Eigen/Core>
+#include <exception>
+#include <string>
+#include <vector>
+
+#include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/manifold.hpp"
+#include "varia/core/mechanics.hpp"
+#include "varia/core/one_step.hpp"
+
+namespace varia {
+
+enum class PhaseSpace { tangent, cotangent };
+
+// Throws std::invalid_argument unless the manifold is a vector space (Rn) whose dimension the
+// Lagrangian's sizes match: the constructions that integrate a MechanicalField need it.
+void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian,
+                          const char* construction);
+
+class MechanicalField final : public VectorField {
+ public:
+  // Throws std::invalid_argument unless the Lagrangian declares a constant mass matrix.
+  MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space);
+  int size() const noexcept override { return 2 * n_; }
+  Status eval(const double* y, double* f) noexcept override;
+  Status eval(const Jet2* y, Jet2* f) noexcept override;
+  Status jacobian(const double* y, double* f, double* df) noexcept override;
+
+  // y1 = Psi_h(y0) by `method`, its stage iterations recorded in `stages`. Throws
+  // NumericalFailure (stage equations that do not converge, a non-finite state) or PluginFault.
+  void step(OneStepMethod& method, double h, const double* y0, double* y1,
+            SolverStatistics& stages);
+  void step(OneStepMethod& method, double h, const Jet2* y0, Jet2* y1, SolverStatistics& stages);
+
+  const Eigen::MatrixXd& mass() const { return mass_; }
+  // x = M^{-1} w, at doubles or jets: the velocity of a momentum, the acceleration of a force.
+  void inverse_mass(const double* w, double* x) const;
+  void inverse_mass(const Jet2* w, Jet2* x) const;
+  // The velocity of a state's second half: v = w (tangent) or M^{-1} w (cotangent).
+  void velocity(const Jet2* w, Jet2* v) const;
+
+ private:
+  template <class F>
+  Status guard(F&& f) noexcept;
+  template <class T>
+  void advance(OneStepMethod& method, double h, const T* y0, T* y1, SolverStatistics& stages);
+
+  LagrangianEvaluator& lagrangian_;
+  PhaseSpace space_;
+  int n_;
+  Eigen::MatrixXd mass_, inverse_mass_;
+  std::exception_ptr pending_;  // what made the last callback fail, rethrown after the step
+  std::string message_;
+  // Workspace, sized once.
+  Eigen::VectorXd v_, gradient_;
+  Eigen::MatrixXd hessian_;
+  std::vector<Jet2> v_jet_, gradient_jet_;
+};
+
+}  // namespace varia

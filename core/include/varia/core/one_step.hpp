@@ -1,0 +1,53 @@
+// One-step methods Psi_h for an autonomous ODE y' = f(y) on R^N (paper, sec. 3: the method that
+// a shooting-based discrete Lagrangian is built from). The caller owns the vector field and
+// passes it to every step; a method steps both doubles and second-order jets (jet.hpp), so that
+// the shooting construction obtains the exact first and second sensitivities of the propagation.
+#pragma once
+
+#include "varia/core/jet.hpp"
+#include "varia/core/plugin_object.hpp"
+
+namespace varia {
+
+// The right-hand side f, provided by the caller (the core), called by the method. Each call
+// returns a Status like every plugin call; a failure ends the step.
+class VectorField {
+ public:
+  virtual ~VectorField() = default;
+  virtual int size() const noexcept = 0;  // N
+  virtual Status eval(const double* y, double* f) noexcept = 0;
+  virtual Status eval(const Jet2* y, Jet2* f) noexcept = 0;
+  // f(y) and its exact Jacobian df/dy (N x N, column-major): the Newton matrix of implicit stages.
+  virtual Status jacobian(const double* y, double* f, double* df) noexcept = 0;
+};
+
+// What an implicit method reports about the nonlinear solves of one step (zeros for explicit
+// methods). On failure to converge the step returns a Status and sets converged = false; the
+// caller then raises a numerical failure rather than a plugin fault.
+struct StageSolve {
+  int iterations = 0;     // Newton iterations of the stage equations
+  double residual = 0.0;  // the last residual norm
+  bool converged = true;
+};
+
+class OneStepMethod : public PluginObject {
+ public:
+  Kind kind() const noexcept final { return Kind::one_step; }
+  // The order p of the global error, whether Psi_h is self-adjoint (Psi_h = Psi_{-h}^{-1}, paper,
+  // sec. 3 "Symmetric shooting-based discrete Lagrangians"), and the maps of R^N it commutes
+  // with ("affine" for Runge-Kutta methods: every tangent-lifted linear or affine group action
+  // on R^n, paper, sec. 3 "Group-invariant shooting-based discrete Lagrangians").
+  virtual int order() const noexcept = 0;
+  virtual bool self_adjoint() const noexcept = 0;
+  virtual const char* equivariance() const noexcept = 0;
+  // Tolerance and iteration limit of the stage equations of implicit methods.
+  virtual void set_solver(double tolerance, int max_iterations) noexcept = 0;
+  // y1 = Psi_h(y0) for y in R^N, N = field.size(). At jets, y1 carries the exact derivatives of
+  // Psi_h(y0) with respect to the variables of y0.
+  virtual Status step(VectorField& field, double h, const double* y0, double* y1,
+                      StageSolve* report) noexcept = 0;
+  virtual Status step(VectorField& field, double h, const Jet2* y0, Jet2* y1,
+                      StageSolve* report) noexcept = 0;
+};
+
+}  // namespace varia

@@ -1,0 +1,39 @@
+// A one-step method run directly on the Euler-Lagrange equations (the scene's construction
+// "one-step"): the comparison methods of the paper's examples (sec. 3, "Examples": the implicit
+// midpoint rule MID, the 2-stage Gauss method SRK4). (q0, p0) -> (q0, v0 = M^{-1} p0), one step
+// of Psi_h on TQ, then p1 = M v1. Not variational unless the method is symplectic.
+#pragma once
+
+#include <Eigen/Core>
+
+#include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/manifold.hpp"
+#include "varia/core/mechanical_field.hpp"
+#include "varia/core/mechanics.hpp"
+#include "varia/core/one_step.hpp"
+
+namespace varia {
+
+class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
+ public:
+  // Throws std::invalid_argument unless the manifold is a vector space and the Lagrangian has a
+  // constant mass matrix.
+  OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian, OneStepMethod& method,
+                        SolverOptions options);
+  int point_size() const override { return n_; }
+  int dim() const override { return n_; }
+  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
+  // The method's stage solves (zeros for explicit methods).
+  const SolverStatistics& solver_statistics() const override { return statistics_; }
+  const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
+
+ private:
+  LagrangianEvaluator lagrangian_;
+  MechanicalField field_;
+  OneStepMethod& method_;
+  int n_;
+  SolverStatistics statistics_;
+  Eigen::VectorXd y0_, y1_;
+};
+
+}  // namespace varia

@@ -1,0 +1,209 @@
+// SO(3), the rotations of R^3, as 3x3 matrices: the group of the paper's rigid-body examples
+// (sec. 2, "Example: Lie group velocity Verlet"). Invariant: a point R satisfies R^T R = I and
+// det R = 1 to round-off; the functions below map onto the group exactly in exact arithmetic
+// (Rodrigues, Cayley) and never project back onto it. The Lie algebra so(3) is R^3 through the hat
+// map, hat(w) x = w x x; tangents and momenta are left-trivialized, Rdot = R hat(Omega).
+//
+// Everything is templated on the scalar T, so jets and autodiff scalars pass through; branches
+// are chosen on the real part. The coefficient functions take x = theta^2, theta = |w|, and use
+// their Taylor series for x < kSeriesBound, where the closed forms lose digits to cancellation
+// (and divide by zero at theta = 0); the series are summed to below round-off there.
+#pragma once
+
+#include <Eigen/Core>
+#include <cmath>
+#include <type_traits>
+
+namespace varia::so3 {
+
+template <class T>
+using Vector3 = Eigen::Matrix<T, 3, 1>;
+template <class T>
+using Matrix3 = Eigen::Matrix<T, 3, 3>;
+
+inline constexpr double kSeriesBound = 0.25;  // theta < 1/2
+
+// The real part of a scalar (nested autodiff scalars and jets expose value()).
+template <class T>
+double real(const T& x) {
+  if constexpr (std::is_arithmetic_v<T>)
+    return static_cast<double>(x);
+  else
+    return real(x.value());
+}
+
+template <class T>
+Matrix3<T> hat(const Vector3<T>& w) {
+  Matrix3<T> W;
+  W << T(0), -w(2), w(1), w(2), T(0), -w(0), -w(1), w(0), T(0);
+  return W;
+}
+
+// The inverse of hat on skew matrices; vee(M) = (M32, M13, M21), so vee(M - M^T) / 2 is the
+// axial vector of the skew part of any M.
+template <class T>
+Vector3<T> vee(const Matrix3<T>& M) {
+  return Vector3<T>(M(2, 1), M(0, 2), M(1, 0));
+}
+
+// sum_k c[k] x^k by Horner's rule.
+template <class T, std::size_t N>
+T series(const T& x, const double (&c)[N]) {
+  T sum = T(c[N - 1]);
+  for (std::size_t k = N - 1; k-- > 0;) sum = sum * x + T(c[k]);
+  return sum;
+}
+
+// sin(theta)/theta.
+template <class T>
+T sinc(const T& x) {
+  using std::sin;
+  using std::sqrt;
+  static constexpr double c[] = {1.0, -1.0 / 6, 1.0 / 120, -1.0 / 5040, 1.0 / 362880,
+                                 -1.0 / 39916800, 1.0 / 6227020800, -1.0 / 1307674368000};
+  if (real(x) < kSeriesBound) return series(x, c);
+  const T theta = sqrt(x);
+  return sin(theta) / theta;
+}
+
+// (1 - cos theta)/theta^2 = sinc(theta/2)^2 / 2, free of cancellation.
+template <class T>
+T cosc(const T& x) {
+  const T half = sinc(T(x / 4.0));
+  return half * half / 2.0;
+}
+
+// (theta - sin theta)/theta^3.
+template <class T>
+T sinc3(const T& x) {
+  using std::sin;
+  using std::sqrt;
+  static constexpr double c[] = {1.0 / 6,        -1.0 / 120,        1.0 / 5040,
+                                 -1.0 / 362880,  1.0 / 39916800,    -1.0 / 6227020800,
+                                 1.0 / 1307674368000, -1.0 / 355687428096000};
+  if (real(x) < kSeriesBound) return series(x, c);
+  const T theta = sqrt(x);
+  return (theta - sin(theta)) / (x * theta);
+}
+
+// (1 - (theta/2) cot(theta/2))/theta^2, the coefficient of dexp^{-1}; singular at theta = 2 pi.
+template <class T>
+T cotc(const T& x) {
+  using std::sqrt;
+  using std::tan;
+  static constexpr double c[] = {1.0 / 12,         1.0 / 720,        1.0 / 30240,
+                                 1.0 / 1209600,    1.0 / 47900160,   691.0 / 1307674368000,
+                                 1.0 / 74724249600, 3617.0 / 10670622842880000};
+  if (real(x) < kSeriesBound) return series(x, c);
+  const T half = sqrt(x) / 2.0;
+  return (T(1.0) - half / tan(half)) / x;
+}
+
+// exp(hat(w)) - I by Rodrigues' formula (paper, eq. rodc): sinc hat(w) + cosc hat(w)^2. Kept
+// apart from I so that updates R + R (exp - I) can be summed with compensation.
+template <class T>
+Matrix3<T> expm1(const Vector3<T>& w) {
+  const T x = w.squaredNorm();
+  const Matrix3<T> W = hat(w);
+  return sinc(x) * W + cosc(x) * (W * W);
+}
+
+template <class T>
+Matrix3<T> exp(const Vector3<T>& w) {
+  return Matrix3<T>::Identity() + expm1(w);
+}
+
+// The rotation angle theta in [0, pi] and the axial vector s = sin(theta) n of R = exp(theta n).
+template <class T>
+Vector3<T> axial(const Matrix3<T>& R) {
+  return vee(Matrix3<T>(R - R.transpose())) / 2.0;
+}
+
+// log R, the w with |w| <= pi and exp(hat(w)) = R. With s = sin(theta) n from axial(R) and
+// cos theta = (tr R - 1)/2: w = (theta / sin theta) s, theta = atan2(|s|, cos theta), accurate at
+// every angle, and summed as the series of asin(y)/y in y^2 = |s|^2 near theta = 0. Near pi
+// (cos theta < 0) s loses its digits, and the axis n comes from the symmetric part
+// R + R^T = 2 cos theta I + 2 (1 - cos theta) n n^T, its sign from s.
+template <class T>
+Vector3<T> log(const Matrix3<T>& R) {
+  using std::atan2;
+  using std::sqrt;
+  static constexpr double asin_over[] = {1.0, 1.0 / 6, 3.0 / 40, 5.0 / 112, 35.0 / 1152};
+  constexpr double kSmallSine2 = 1e-4;  // below it, the series' next term is under 1e-21
+  const Vector3<T> s = axial(R);
+  const T cosine = (R.trace() - 1.0) / 2.0, sine2 = s.squaredNorm();
+  if (real(cosine) >= 0.0) {
+    if (real(sine2) < kSmallSine2) return series(sine2, asin_over) * s;
+    const T sine = sqrt(sine2);
+    return (atan2(sine, cosine) / sine) * s;
+  }
+  const Matrix3<T> nn = (R + R.transpose() - 2.0 * cosine * Matrix3<T>::Identity()) /
+                        (2.0 * (1.0 - cosine));
+  int k = 0;
+  for (int i = 1; i < 3; ++i)
+    if (real(nn(i, i)) > real(nn(k, k))) k = i;
+  Vector3<T> n = nn.col(k) / sqrt(nn(k, k));
+  if (real(n.dot(s)) < 0.0) n = -n;
+  return atan2(sqrt(sine2), cosine) * n;
+}
+
+// dexp_w = sum_n ad_w^n/(n+1)! = I + cosc hat(w) + sinc3 hat(w)^2 (paper, sec. 2: T_w exp =
+// dexp_w exp(w) in right trivialization); the left-trivialized velocity of exp(xi(t)) is
+// dexp_{-xi} xi'.
+template <class T>
+Matrix3<T> dexp(const Vector3<T>& w) {
+  const T x = w.squaredNorm();
+  const Matrix3<T> W = hat(w);
+  return Matrix3<T>::Identity() + cosc(x) * W + sinc3(x) * (W * W);
+}
+
+// dexp_w^{-1} = I - hat(w)/2 + cotc hat(w)^2, for |w| < 2 pi.
+template <class T>
+Matrix3<T> dexp_inverse(const Vector3<T>& w) {
+  const T x = w.squaredNorm();
+  const Matrix3<T> W = hat(w);
+  return Matrix3<T>::Identity() - 0.5 * W + cotc(x) * (W * W);
+}
+
+// cay(f) - I for cay(f) = (I + hat f)(I - hat f)^{-1} (paper, eq. FCay), which is
+// I + 2/(1 + |f|^2) (hat f + hat f^2), the rotation by 2 atan|f| about f.
+template <class T>
+Matrix3<T> cayley_minus_identity(const Vector3<T>& f) {
+  const Matrix3<T> W = hat(f);
+  return (2.0 / (1.0 + f.squaredNorm())) * (W + W * W);
+}
+
+template <class T>
+Matrix3<T> cayley(const Vector3<T>& f) {
+  return Matrix3<T>::Identity() + cayley_minus_identity(f);
+}
+
+// cay^{-1}(F) = vee(F - F^T)/(1 + tr F), for rotations by less than pi.
+template <class T>
+Vector3<T> cayley_inverse(const Matrix3<T>& F) {
+  return vee(Matrix3<T>(F - F.transpose())) / (1.0 + F.trace());
+}
+
+// The left-trivialized gradient at R of a function with embedding gradient G = df/dR:
+// tau . eta = <G, R hat(eta)> for all eta, i.e. tau = vee(R^T G - G^T R).
+template <class T>
+Vector3<T> trivialize(const Matrix3<T>& R, const Matrix3<T>& G) {
+  const Matrix3<T> A = R.transpose() * G;
+  return vee(Matrix3<T>(A - A.transpose()));
+}
+
+// ||I - R^T R||_F, the distance of R from the orthogonal matrices that the paper plots.
+template <class T>
+T orthogonality_error(const Matrix3<T>& R) {
+  return (Matrix3<T>::Identity() - R.transpose() * R).norm();
+}
+
+// Row-major 9-number buffers <-> matrices (the spec's layout of a point).
+inline Matrix3<double> from_row_major(const double* q) {
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(q);
+}
+inline void to_row_major(const Matrix3<double>& R, double* q) {
+  Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>{q} = R;
+}
+
+}  // namespace varia::so3

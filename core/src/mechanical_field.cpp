@@ -1,0 +1,147 @@
+#include "varia/core/mechanical_field.hpp"
+
+#include <Eigen/LU>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace varia {
+
+void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian,
+                          const char* construction) {
+  if (!manifold.is_vector_space())
+    throw std::invalid_argument(std::string(construction) + " needs a vector-space manifold (Rn)");
+  const int n = manifold.dim();
+  if (lagrangian.position_size() != n || lagrangian.velocity_size() != n)
+    throw std::invalid_argument("the Lagrangian's sizes do not match the manifold's dimension");
+}
+
+MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space)
+    : lagrangian_(lagrangian),
+      space_(space),
+      n_(lagrangian.velocity_size()),
+      mass_(n_, n_),
+      v_(n_),
+      gradient_(2 * n_),
+      hessian_(2 * n_, 2 * n_),
+      v_jet_(n_),
+      gradient_jet_(2 * n_) {
+  if (!lagrangian.plugin().constant_mass_matrix(mass_.data()))
+    throw std::invalid_argument(
+        "one-step methods and the shooting construction need a Lagrangian with a constant mass "
+        "matrix, L = 1/2 v^T M v - V(q) (Lagrangian::constant_mass_matrix); this one declares "
+        "none");
+  inverse_mass_ = mass_.inverse();
+}
+
+template <class F>
+Status MechanicalField::guard(F&& f) noexcept {
+  try {
+    f();
+    return nullptr;
+  } catch (const std::exception& e) {
+    message_ = e.what();
+  } catch (...) {
+    message_ = "unknown exception";
+  }
+  pending_ = std::current_exception();
+  return message_.c_str();
+}
+
+void MechanicalField::inverse_mass(const double* w, double* x) const {
+  Eigen::Map<Eigen::VectorXd>(x, n_).noalias() =
+      inverse_mass_ * Eigen::Map<const Eigen::VectorXd>(w, n_);
+}
+
+void MechanicalField::inverse_mass(const Jet2* w, Jet2* x) const {
+  for (int r = 0; r < n_; ++r) {
+    Jet2 sum;
+    for (int c = 0; c < n_; ++c)
+      if (inverse_mass_(r, c) != 0.0) sum += inverse_mass_(r, c) * w[c];
+    x[r] = sum;
+  }
+}
+
+void MechanicalField::velocity(const Jet2* w, Jet2* v) const {
+  if (space_ == PhaseSpace::cotangent) return inverse_mass(w, v);
+  std::copy(w, w + n_, v);
+}
+
+Status MechanicalField::eval(const double* y, double* f) noexcept {
+  return guard([&] {
+    if (space_ == PhaseSpace::cotangent) inverse_mass(y + n_, v_.data());
+    else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
+    lagrangian_.gradient(y, v_.data(), gradient_.data());
+    Eigen::Map<Eigen::VectorXd>(f, n_) = v_;
+    if (space_ == PhaseSpace::cotangent) Eigen::Map<Eigen::VectorXd>(f + n_, n_) = gradient_.head(n_);
+    else inverse_mass(gradient_.data(), f + n_);
+  });
+}
+
+Status MechanicalField::eval(const Jet2* y, Jet2* f) noexcept {
+  return guard([&] {
+    velocity(y + n_, v_jet_.data());
+    lagrangian_.gradient_jet(y, v_jet_.data(), nullptr, gradient_jet_.data());
+    std::copy(v_jet_.begin(), v_jet_.end(), f);
+    if (space_ == PhaseSpace::cotangent) std::copy_n(gradient_jet_.begin(), n_, f + n_);
+    else inverse_mass(gradient_jet_.data(), f + n_);
+  });
+}
+
+// Tangent:   df = [0, I; M^{-1} L_qq, M^{-1} L_qv].
+// Cotangent: df = [0, M^{-1}; L_qq, L_qv M^{-1}]  (v = M^{-1} p).
+Status MechanicalField::jacobian(const double* y, double* f, double* df) noexcept {
+  return guard([&] {
+    if (space_ == PhaseSpace::cotangent) inverse_mass(y + n_, v_.data());
+    else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
+    lagrangian_.hessian(y, v_.data(), gradient_.data(), hessian_.data());
+    Eigen::Map<Eigen::VectorXd> rate(f, 2 * n_);
+    Eigen::Map<Eigen::MatrixXd> J(df, 2 * n_, 2 * n_);
+    rate.head(n_) = v_;
+    J.topLeftCorner(n_, n_).setZero();
+    if (space_ == PhaseSpace::cotangent) {
+      rate.tail(n_) = gradient_.head(n_);
+      J.topRightCorner(n_, n_) = inverse_mass_;
+      J.bottomLeftCorner(n_, n_) = hessian_.topLeftCorner(n_, n_);
+      J.bottomRightCorner(n_, n_).noalias() = hessian_.topRightCorner(n_, n_) * inverse_mass_;
+    } else {
+      rate.tail(n_).noalias() = inverse_mass_ * gradient_.head(n_);
+      J.topRightCorner(n_, n_).setIdentity();
+      J.bottomLeftCorner(n_, n_).noalias() = inverse_mass_ * hessian_.topLeftCorner(n_, n_);
+      J.bottomRightCorner(n_, n_).noalias() = inverse_mass_ * hessian_.topRightCorner(n_, n_);
+    }
+  });
+}
+
+namespace {
+double value_of(double x) { return x; }
+double value_of(const Jet2& x) { return x.value; }
+}  // namespace
+
+template <class T>
+void MechanicalField::advance(OneStepMethod& method, double h, const T* y0, T* y1,
+                              SolverStatistics& stages) {
+  StageSolve report;
+  pending_ = nullptr;
+  if (Status status = method.step(*this, h, y0, y1, &report)) {
+    if (pending_) std::rethrow_exception(pending_);
+    if (!report.converged) throw NumericalFailure(status, report.residual);
+    throw PluginFault(std::string("one-step method: ") + status);
+  }
+  stages.record(report.iterations);
+  for (int r = 0; r < 2 * n_; ++r)
+    if (!std::isfinite(value_of(y1[r])))
+      throw NumericalFailure("the one-step method produced a non-finite state", std::nan(""));
+}
+
+void MechanicalField::step(OneStepMethod& method, double h, const double* y0, double* y1,
+                           SolverStatistics& stages) {
+  advance(method, h, y0, y1, stages);
+}
+
+void MechanicalField::step(OneStepMethod& method, double h, const Jet2* y0, Jet2* y1,
+                           SolverStatistics& stages) {
+  advance(method, h, y0, y1, stages);
+}
+
+}  // namespace varia

@@ -1,0 +1,26 @@
+// Plots rendered by gnuplot (a Debian package) into SVG: panels side by side, each with labelled
+// axes, a legend and optional log scales. Used by `run --plot` and `cost`.
+#pragma once
+
+#include <filesystem>
+#include <string>
+#include <vector>
+
+namespace varia::host {
+
+struct Series {
+  std::string title;
+  std::vector<double> x, y;
+  bool dashed = false;  // reference lines (e.g. a predicted slope)
+};
+
+struct Panel {
+  std::string title, xlabel, ylabel;
+  bool logx = false, logy = false;
+  std::vector<Series> series;
+};
+
+// Writes `file` (SVG); throws std::runtime_error when gnuplot is missing or fails.
+void write_svg(const std::filesystem::path& file, const std::vector<Panel>& panels);
+
+}  // namespace varia::host
