@@ -1,5 +1,7 @@
 #include "varia/core/lie_verlet.hpp"
 
+#include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>

@@ -86,7 +86,7 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   Bw_.resize(n_, n_);
   phi_.resize(2 * n_, 2 * n_);
   jacobian_.resize(n_, n_);
-  Bw_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
+  BwT_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
   jacobian_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
   residuals_.reserve(options_.max_iterations + 1);
 }
@@ -139,8 +139,8 @@ void ShootingDiscreteLagrangian::differentiate() {
     Bq_.row(r) = boundary_[r].gradient.head(n_).transpose();
     Bw_.row(r) = boundary_[r].gradient.tail(n_).transpose();
   }
-  Bw_lu_.compute(Bw_);
-  lambda_.noalias() = Bw_lu_.transpose().solve(generating_.gradient.tail(n_));
+  BwT_lu_.compute(Bw_.transpose());
+  lambda_.noalias() = BwT_lu_.solve(generating_.gradient.tail(n_));
   D1_ = generating_.gradient.head(n_);
   D1_.noalias() -= Bq_.transpose() * lambda_;
   phi_ = generating_.hessian;
@@ -156,9 +156,11 @@ void ShootingDiscreteLagrangian::residual(Target target, const double* data) {
   const auto phi_ww = phi_.bottomRightCorner(n_, n_);
   switch (target) {
     case Target::momentum:
-      residual_ = type_2() ? D1_ - given : D1_ + given;
+      residual_ = D1_;
+      if (type_2()) residual_ -= given;
+      else residual_ += given;
       jacobian_ = phi_.topRightCorner(n_, n_);
-      jacobian_.noalias() -= Bq_.transpose() * Bw_lu_.transpose().solve(phi_ww);
+      jacobian_.noalias() -= Bq_.transpose() * BwT_lu_.solve(phi_ww);
       break;
     case Target::boundary:
       for (int r = 0; r < n_; ++r) residual_[r] = boundary_[r].value - given[r];
@@ -166,7 +168,7 @@ void ShootingDiscreteLagrangian::residual(Target target, const double* data) {
       break;
     case Target::lambda:
       residual_ = lambda_ - given;
-      jacobian_ = Bw_lu_.transpose().solve(phi_ww);
+      jacobian_ = BwT_lu_.solve(phi_ww);
       break;
   }
 }

@@ -6,32 +6,19 @@
 // reference to its shared_library, so a library never unloads under a live object.
 #pragma once
 
-#include <boost/dll/shared_library.hpp>
 #include <filesystem>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
-#include <stdexcept>
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "errors.hpp"
 #include "varia/core/plugin_object.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::host {
-
-// Bad input (exit code 2): the message names what was wrong and what was expected.
-class InputError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
-// A plugin that cannot be loaded or misbehaves (exit code 3): the message names the file.
-// (varia::PluginFault from core is the same exit code.)
-class PluginLoadError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
 
 struct PluginRecord {
   std::filesystem::path file;
@@ -44,12 +31,27 @@ struct Refusal {
   std::string reason;
 };
 
+// The kind and type a candidate's marker symbol declares (type with '_' already read as '-').
+struct Marker {
+  std::string kind, type;
+};
+
+// What the symbol table of a candidate says, read without loading it.
+struct SymbolScan {
+  bool parsed = false;            // false: not a binary boost::dll can read
+  bool has_symbol_table = false;  // false: stripped; find() must load it to learn its type
+  std::vector<Marker> markers;
+};
+
 class Registry {
  public:
   // The directories searched, in order: the bundled plugins (found relative to the running
   // executable), each of `plugin_paths`, then VARIA_PLUGIN_PATH (colon-separated).
   static std::vector<std::filesystem::path> search_path(const std::vector<std::string>& plugin_paths);
   explicit Registry(std::vector<std::filesystem::path> directories);
+  ~Registry();
+  Registry(const Registry&) = delete;
+  Registry& operator=(const Registry&) = delete;
 
   // Every plugin found, loading every candidate; the refused files with their reasons.
   std::vector<PluginRecord> list(std::vector<Refusal>& refused);
@@ -58,7 +60,8 @@ class Registry {
   // and PluginLoadError naming both files for a duplicate type name.
   const PluginRecord& find(const std::string& kind, const std::string& type);
   // Constructs an object of a plugin found with find(); parameters are those of the scene's
-  // object (its "type" key removed), already validated against the plugin's schema.
+  // object (its "type" key removed), already validated against the plugin's schema. Throws
+  // PluginLoadError "<file>: <type>: <message>" when the plugin refuses to construct it.
   std::shared_ptr<PluginObject> create(const std::string& kind, const std::string& type,
                                        const nlohmann::json& parameters,
                                        const sdk::Context& context);
@@ -72,7 +75,17 @@ class Registry {
 
  private:
   struct Loaded;
+  // Loads one candidate and checks its ABI version and metadata; the metadata must agree with the
+  // markers of its symbol table. Throws PluginLoadError "<file>: <reason>".
+  static std::shared_ptr<Loaded> load(const std::filesystem::path& file, const SymbolScan& scan);
+  const SymbolScan& scan(const std::filesystem::path& file);  // read once per file
+  const std::vector<std::filesystem::path>& candidates();
+  std::vector<std::filesystem::path> files_declaring(const std::string& kind, const std::string& type);
+  std::string valid_types(const std::string& kind);
+
   std::vector<std::filesystem::path> directories_;
+  std::optional<std::vector<std::filesystem::path>> candidates_;
+  std::map<std::filesystem::path, SymbolScan> scans_;
   std::map<std::string, std::shared_ptr<Loaded>> loaded_;  // key: kind + "/" + type
   std::vector<std::string> load_order_;
 };

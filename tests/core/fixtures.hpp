@@ -6,6 +6,7 @@
 
 #include "varia/core/manifold.hpp"
 #include "varia/core/quadrature.hpp"
+#include "varia/core/so3.hpp"
 #include "varia/sdk/autodiff_lagrangian.hpp"
 
 namespace varia::testing {
@@ -59,6 +60,43 @@ struct Pendulum : sdk::AutodiffLagrangian<Pendulum> {
     using std::cos;
     return 0.5 * v(0) * v(0) + cos(q(0));
   }
+};
+
+// SO(3) in process (varia/core/so3.hpp): points are row-major rotation matrices.
+struct Rotations : Manifold {
+  int point_size() const noexcept override { return 9; }
+  int dim() const noexcept override { return 3; }
+  bool is_vector_space() const noexcept override { return false; }
+  Status retract(const double* q0, const double* xi, double* q) noexcept override {
+    so3::to_row_major(so3::from_row_major(q0) * so3::exp(Eigen::Vector3d(xi[0], xi[1], xi[2])), q);
+    return nullptr;
+  }
+  Status local(const double* q0, const double* q, double* xi) noexcept override {
+    const Eigen::Matrix3d D = so3::from_row_major(q0).transpose() * so3::from_row_major(q);
+    Eigen::Map<Eigen::Vector3d>{xi} = so3::log(D);
+    return nullptr;
+  }
+  bool contains(const double*, char*, int) noexcept override { return true; }
+};
+
+// A top with principal moments J and weight w = m g at the body offset chi (w = 0: the free rigid
+// body): L = 1/2 Omega . J Omega - w e3 . (R chi), R row-major in q.
+struct Top : sdk::AutodiffLagrangian<Top> {
+  Top(Eigen::Vector3d J, double w, Eigen::Vector3d chi)
+      : sdk::AutodiffLagrangian<Top>(9, 3), J(J), w(w), chi(chi) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    T L = T(0.0);
+    for (int i = 0; i < 3; ++i) L += T(0.5 * J(i)) * v(i) * v(i) - T(w * chi(i)) * q(6 + i);
+    return L;
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    Eigen::Map<Eigen::Matrix3d>{mass} = J.asDiagonal();
+    return true;
+  }
+  Eigen::Vector3d J;
+  double w;
+  Eigen::Vector3d chi;
 };
 
 }  // namespace varia::testing

@@ -11,7 +11,7 @@
 namespace varia {
 
 // Bumped whenever a virtual interface below or in the kind headers changes layout.
-inline constexpr int kAbiVersion = 2;  // 2: Lagrangian::gradient_jet, OneStepMethod
+inline constexpr int kAbiVersion = 3;  // 2: Lagrangian::gradient_jet, OneStepMethod; 3: Manifold::constraint_error
 
 using Status = const char*;
 

@@ -103,7 +103,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Jet2 generating_;
   Eigen::VectorXd w_, lambda_, D1_, residual_, update_;
   Eigen::MatrixXd Bq_, Bw_, phi_, jacobian_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> Bw_lu_, jacobian_lu_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> BwT_lu_, jacobian_lu_;  // of B_w^T and the Jacobian
 };
 
 }  // namespace varia

@@ -4,7 +4,9 @@
 //
 //   template <class T> T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const;
 //
-// Derivative vectors have a fixed capacity, so an evaluation allocates nothing.
+// Derivative vectors have a fixed capacity, so an evaluation allocates nothing. The same model,
+// evaluated at a dual number over second-order jets, gives gradient_jet (at most
+// kMaxJetVariables position and velocity numbers together).
 #pragma once
 
 #include <Eigen/Core>
@@ -21,6 +23,10 @@ template <class T>
 using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, kMaxAutodiffVariables, 1>;
 using Dual = Eigen::AutoDiffScalar<Vec<double>>;
 using Dual2 = Eigen::AutoDiffScalar<Vec<Dual>>;
+// First derivatives at jet inputs (Lagrangian::gradient_jet): at most kMaxJetVariables numbers
+// m + n, which keeps a Vec of these scalars within Eigen's stack allocation limit.
+using JetDual = Eigen::AutoDiffScalar<
+    Eigen::Matrix<Jet2, Eigen::Dynamic, 1, 0, kMaxJetVariables, 1>>;
 
 template <class Model>
 class AutodiffLagrangian : public Lagrangian {
@@ -44,6 +50,24 @@ class AutodiffLagrangian : public Lagrangian {
       else if (value != nullptr)
         *value = model().lagrangian(Vec<double>(Eigen::Map<const Vec<double>>(q, m_)),
                                     Vec<double>(Eigen::Map<const Vec<double>>(v, n_)));
+    });
+  }
+
+  Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final {
+    return guarded(error_, [&] {
+      const int k = m_ + n_;
+      if (k > kMaxJetVariables)
+        throw std::invalid_argument("evaluation at jets takes at most " +
+                                    std::to_string(kMaxJetVariables) +
+                                    " position and velocity numbers together");
+      Vec<JetDual> qd(m_), vd(n_);
+      for (int i = 0; i < k; ++i) {
+        JetDual z(i < m_ ? q[i] : v[i - m_], k, i);
+        (i < m_ ? qd(i) : vd(i - m_)) = z;
+      }
+      const JetDual r = model().lagrangian(qd, vd);
+      if (value != nullptr) *value = r.value();
+      for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : Jet2();
     });
   }
 

@@ -1,0 +1,238 @@
+#include "varia/core/verification.hpp"
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <sstream>
+
+namespace varia {
+
+namespace {
+
+using Construction = Composition::Construction;
+
+Predictions predict_galerkin(const Composition& c) {
+  Predictions p;
+  const int order = std::min(2 * c.degree, c.quadrature_order);
+  p.ld_order = p.global_order = order;
+  p.self_adjoint = c.quadrature_symmetric && c.control_times_symmetric;
+  p.symplectic = p.energy_bounded = true;
+  p.reason = "Galerkin (sec. 2): order min(2s, quadrature order); self-adjoint for a symmetric "
+             "rule and control times; G-invariant L_d from an equivariant interpolant";
+  return p;
+}
+
+Predictions predict_shooting(const Composition& c) {
+  Predictions p;
+  p.ld_order = p.global_order = std::min(c.method_order, c.quadrature_order);
+  p.self_adjoint = c.method_self_adjoint && c.quadrature_symmetric;
+  p.symplectic = p.energy_bounded = true;
+  p.reason = "shooting (sec. 3 theorem): order min(p, q); self-adjoint for a self-adjoint method "
+             "and a symmetric rule; G-invariant for a G-equivariant method";
+  return p;
+}
+
+Predictions predict_one_step(const Composition& c) {
+  Predictions p;
+  p.global_order = c.method_order;
+  p.self_adjoint = c.method_self_adjoint;
+  p.symplectic = c.method_symplectic;
+  if (c.method_symplectic) p.energy_bounded = true;
+  p.reason = "one-step method: its declared order, self-adjointness and symplecticity (no L_d)";
+  return p;
+}
+
+Predictions predict_lie_verlet() {
+  Predictions p;
+  p.ld_order = p.global_order = 2;
+  p.self_adjoint = p.symplectic = p.energy_bounded = true;
+  p.reason = "Lie group velocity Verlet (sec. 2 example): order 2, symplectic, G-invariant";
+  return p;
+}
+
+}  // namespace
+
+Predictions predict(const Composition& c) {
+  Predictions p;
+  switch (c.construction) {
+    case Construction::galerkin: p = predict_galerkin(c); break;
+    case Construction::shooting: p = predict_shooting(c); break;
+    case Construction::one_step: p = predict_one_step(c); break;
+    case Construction::lie_verlet: p = predict_lie_verlet(); break;
+  }
+  // Discrete Noether theorem (sec. 1): a G-invariant L_d conserves the discrete momentum map.
+  if (c.lagrangian_invariant) {
+    const bool invariant = c.construction == Construction::galerkin ||
+                           c.construction == Construction::lie_verlet ||
+                           (c.construction == Construction::shooting && c.method_equivariant);
+    if (c.construction != Construction::one_step) p.g_invariant = invariant;
+    if (invariant) p.momentum_conserved = true;
+    else if (c.construction == Construction::one_step && c.method_symplectic && c.method_equivariant)
+      p.momentum_conserved = true;
+  }
+  return p;
+}
+
+OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor) {
+  OrderFit fit;
+  std::vector<int> kept;
+  for (std::size_t k = 0; k < h.size(); ++k) {
+    std::ostringstream why;
+    if (!(error[k] > floor)) {
+      why << "h = " << h[k] << ": error " << error[k] << " at round-off (below " << floor << ")";
+      fit.dropped.push_back(why.str());
+    } else {
+      kept.push_back(static_cast<int>(k));
+    }
+  }
+  auto local = [&](std::size_t a) {
+    return std::log(error[kept[a]] / error[kept[a + 1]]) / std::log(h[kept[a]] / h[kept[a + 1]]);
+  };
+  while (kept.size() >= 4 && std::abs(local(0) - local(1)) > 0.3) {
+    std::ostringstream why;
+    why << "h = " << h[kept[0]] << ": pre-asymptotic (local slope " << local(0) << ", next "
+        << local(1) << ")";
+    fit.dropped.push_back(why.str());
+    kept.erase(kept.begin());
+  }
+  fit.used = static_cast<int>(kept.size());
+  if (kept.size() < 2) return fit;
+  double mx = 0, my = 0;
+  for (int k : kept) mx += std::log(h[k]), my += std::log(error[k]);
+  mx /= kept.size();
+  my /= kept.size();
+  double sxy = 0, sxx = 0;
+  for (int k : kept) {
+    sxy += (std::log(h[k]) - mx) * (std::log(error[k]) - my);
+    sxx += (std::log(h[k]) - mx) * (std::log(h[k]) - mx);
+  }
+  fit.slope = sxy / sxx;
+  return fit;
+}
+
+std::vector<SamplePair> sample_pairs(Manifold& manifold, const double* q, const double* v, double h,
+                                     int count) {
+  const int n = manifold.dim(), m = manifold.point_size();
+  std::mt19937 random(12345);
+  std::uniform_real_distribution<double> uniform(-1.0, 1.0);
+  std::vector<SamplePair> pairs;
+  Eigen::VectorXd shift(n);
+  for (int k = 0; k < count; ++k) {
+    SamplePair pair{std::vector<double>(m), std::vector<double>(m)};
+    for (int i = 0; i < n; ++i) shift[i] = 0.1 * uniform(random);
+    check(manifold.retract(q, shift.data(), pair.q0.data()), "retract");
+    for (int i = 0; i < n; ++i) shift[i] = h * (v[i] + 0.1 * uniform(random));
+    check(manifold.retract(pair.q0.data(), shift.data(), pair.q1.data()), "retract");
+    pairs.push_back(std::move(pair));
+  }
+  return pairs;
+}
+
+double self_adjointness_residual(DiscreteLagrangian& Ld, const std::vector<SamplePair>& pairs,
+                                 double h) {
+  double worst = 0.0;
+  for (const auto& pair : pairs) {
+    double forward = 0.0, backward = 0.0;
+    Ld.evaluate(pair.q0.data(), pair.q1.data(), h, &forward, nullptr, nullptr);
+    Ld.evaluate(pair.q1.data(), pair.q0.data(), -h, &backward, nullptr, nullptr);
+    worst = std::max(worst, std::abs(forward + backward) / std::max(std::abs(forward), 1e-300));
+  }
+  return worst;
+}
+
+double invariance_residual(DiscreteLagrangian& Ld, Lagrangian& lagrangian,
+                           const std::vector<SamplePair>& pairs, double h) {
+  double worst = 0.0;
+  unsigned seed = 1;
+  for (const auto& pair : pairs) {
+    std::vector<double> g0(pair.q0.size()), g1(pair.q1.size());
+    check(lagrangian.act(seed, pair.q0.data(), nullptr, g0.data(), nullptr), "group action");
+    check(lagrangian.act(seed, pair.q1.data(), nullptr, g1.data(), nullptr), "group action");
+    ++seed;
+    double original = 0.0, moved = 0.0;
+    Ld.evaluate(pair.q0.data(), pair.q1.data(), h, &original, nullptr, nullptr);
+    Ld.evaluate(g0.data(), g1.data(), h, &moved, nullptr, nullptr);
+    worst = std::max(worst, std::abs(moved - original) / std::max(std::abs(original), 1e-300));
+  }
+  return worst;
+}
+
+void exact_discrete_lagrangian(LagrangianEvaluator& lagrangian, const double* nodes,
+                               const double* weights, int points, const double* q0,
+                               const double* v0, double h, double* q1, double* LdE) {
+  Lagrangian& plugin = lagrangian.plugin();
+  std::vector<double> q(lagrangian.position_size()), v(lagrangian.velocity_size());
+  double sum = 0.0;
+  for (int i = 0; i < points; ++i) {
+    check(plugin.exact_solution(q0, v0, nodes[i] * h, q.data(), v.data()), "exact solution");
+    sum += weights[i] * lagrangian.value(q.data(), v.data());
+  }
+  *LdE = h * sum;
+  check(plugin.exact_solution(q0, v0, h, q1, v.data()), "exact solution");
+}
+
+void run(DiscreteHamiltonianMap& map, std::vector<double> q, std::vector<double> p, double h,
+         long steps, const Observer& observe) {
+  std::vector<double> q1(q.size()), p1(p.size());
+  observe(0, q.data(), p.data());
+  for (long k = 1; k <= steps; ++k) {
+    map.step(q.data(), p.data(), h, q1.data(), p1.data());
+    q.swap(q1);
+    p.swap(p1);
+    observe(k, q.data(), p.data());
+  }
+}
+
+namespace {
+
+// Central-difference Jacobian of the one-step map with difference step delta.
+Eigen::MatrixXd jacobian(DiscreteHamiltonianMap& map, const double* q0, const double* p0, double h,
+                         double delta) {
+  const int n = map.dim();
+  Eigen::MatrixXd M(2 * n, 2 * n);
+  Eigen::VectorXd z(2 * n), plus(2 * n), minus(2 * n);
+  for (int i = 0; i < n; ++i) z[i] = q0[i], z[n + i] = p0[i];
+  for (int j = 0; j < 2 * n; ++j) {
+    for (double sign : {1.0, -1.0}) {
+      Eigen::VectorXd w = z;
+      w[j] += sign * delta;
+      Eigen::VectorXd& out = sign > 0 ? plus : minus;
+      map.step(w.data(), w.data() + n, h, out.data(), out.data() + n);
+    }
+    M.col(j) = (plus - minus) / (2 * delta);
+  }
+  return M;
+}
+
+double defect(const Eigen::MatrixXd& M) {
+  const int n = static_cast<int>(M.rows()) / 2;
+  Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2 * n, 2 * n);
+  J.topRightCorner(n, n).setIdentity();
+  J.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
+  return (M.transpose() * J * M - J).cwiseAbs().maxCoeff();
+}
+
+}  // namespace
+
+SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, const double* q0,
+                                         const double* p0, double h) {
+  // Richardson: (4 M(delta/2) - M(delta)) / 3 cancels the O(delta^2) term of central differences.
+  const double delta = 1e-3;
+  auto richardson = [&](double d) {
+    return Eigen::MatrixXd((4.0 * jacobian(map, q0, p0, h, d / 2) - jacobian(map, q0, p0, h, d)) / 3.0);
+  };
+  const double coarse = defect(richardson(delta)), fine = defect(richardson(delta / 2));
+  return {fine, std::abs(fine - coarse) + 1e-13};
+}
+
+double drift_ratio(const std::vector<double>& energy_error) {
+  const std::size_t quarter = std::max<std::size_t>(1, energy_error.size() / 4);
+  double first = 0.0, last = 0.0;
+  for (std::size_t k = 0; k < quarter; ++k) first = std::max(first, std::abs(energy_error[k]));
+  for (std::size_t k = energy_error.size() - quarter; k < energy_error.size(); ++k)
+    last = std::max(last, std::abs(energy_error[k]));
+  return last / std::max(first, 1e-300);
+}
+
+}  // namespace varia

@@ -1,0 +1,36 @@
+// Building the integrator a scene describes: its plugin objects, the construction named by
+// method.construction, and the initial state (spec: "Scene files (JSON)").
+#pragma once
+
+#include <Eigen/Core>
+#include <memory>
+#include <string>
+
+#include "scene.hpp"
+#include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/lagrangian.hpp"
+#include "varia/core/manifold.hpp"
+#include "varia/core/quadrature.hpp"
+
+namespace varia::host {
+
+class Registry;
+
+// The assembled integrator. Members are declared so that the map, which refers to the plugin
+// objects, is destroyed before them.
+struct Assembly {
+  std::shared_ptr<Manifold> manifold;
+  std::shared_ptr<Lagrangian> lagrangian;
+  std::shared_ptr<Quadrature> quadrature;  // when the construction uses one
+  std::unique_ptr<DiscreteHamiltonianMap> map;
+  DiscreteLagrangian* discrete_lagrangian = nullptr;  // when the construction has one (in `map`)
+  Eigen::VectorXd q0, p0;
+  Eigen::VectorXd v0;  // set when the scene gives v or observes energy or momentum
+};
+
+// Creates the plugin objects and the construction; InputError for a construction that is not
+// available, a Lagrangian that does not fit the manifold, a bad initial state or an observable the
+// system does not define.
+Assembly assemble(const Scene& scene, Registry& registry);
+
+}  // namespace varia::host

@@ -1,0 +1,189 @@
+#include "cli.hpp"
+
+#include <fmt/format.h>
+
+#include <CLI/CLI.hpp>
+#include <functional>
+#include <new>
+
+#include "commands.hpp"
+#include "errors.hpp"
+#include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/plugin_object.hpp"
+
+namespace varia::host {
+
+namespace {
+
+// One line, whatever the message holds.
+void report(const std::string& message) {
+  std::string line = message;
+  for (char& c : line)
+    if (c == '\n' || c == '\r') c = ' ';
+  fmt::print(stderr, "varia: error: {}\n", line);
+}
+
+// Spec "Exit codes": 2 bad input, 3 plugin fault, 4 numerical failure.
+int guarded(const std::function<int()>& command) {
+  try {
+    return command();
+  } catch (const InputError& e) {
+    report(e.what());
+    return kExitInput;
+  } catch (const PluginLoadError& e) {
+    report(e.what());
+    return kExitPlugin;
+  } catch (const PluginFault& e) {
+    report(fmt::format("plugin fault: {}", e.what()));
+    return kExitPlugin;
+  } catch (const NumericalFailure& e) {
+    report(fmt::format("numerical failure: {}", e.what()));
+    return kExitNumerical;
+  } catch (const std::invalid_argument& e) {  // a core constructor refusing its arguments
+    report(e.what());
+    return kExitInput;
+  } catch (const std::bad_alloc&) {
+    report("out of memory");
+    return kExitNumerical;
+  } catch (const std::exception& e) {
+    report(fmt::format("unexpected failure: {}", e.what()));
+    return kExitPlugin;
+  }
+}
+
+struct Options {
+  CommonOptions common;
+  std::string scene;
+  std::vector<std::string> scenes;
+  RunOptions run;
+  std::string run_out, run_summary;
+  LdOptions ld;
+  bool json = false;
+  std::string verify_json, cost_out;
+};
+
+CLI::App* subcommand(CLI::App& app, Options& o, const char* name, const char* description, const char* example) {
+  CLI::App* sub = app.add_subcommand(name, description);
+  sub->add_option("--plugin-path", o.common.plugin_paths,
+                  "also search this directory for plugins (repeatable; searched after the bundled plugins, "
+                  "before VARIA_PLUGIN_PATH)")
+      ->type_name("DIR")
+      ->allow_extra_args(false);  // one directory per flag: `--plugin-path DIR SCENE.json`
+  sub->footer(example);
+  return sub;
+}
+
+void add_scene(CLI::App* sub, std::string& scene) {
+  sub->add_option("SCENE", scene, "the scene file (JSON; see schemas/scene.schema.json)")
+      ->required()
+      ->type_name("SCENE.json");
+}
+
+using Command = std::function<int()>;
+
+Command not_available(const char* name) {
+  return [name]() -> int { throw InputError(fmt::format("'{}' is not available yet", name)); };
+}
+
+void define_commands(CLI::App& app, Options& o, Command& chosen) {
+  auto* plugins = subcommand(app, o, "plugins",
+                             "List every plugin found: kind, type name, version, file, declared properties and "
+                             "parameters; files refused are listed after them with the reason.",
+                             "Example:\n  varia plugins\n  varia plugins --json --plugin-path ./my-plugins");
+  plugins->add_flag("--json", o.json, "print a JSON array of objects {kind, type, version, file, properties, "
+                                      "parameter_schema}; refusals go to stderr");
+  plugins->callback([&] { chosen = [&] { return command_plugins(o.common, o.json); }; });
+
+  auto* run = subcommand(app, o, "run",
+                         "Simulate a scene. Without --out no trajectory is written (--out - writes the CSV to "
+                         "stdout, and the human summary then goes to stderr). A short human summary is "
+                         "printed at the end unless --quiet.",
+                         "Example:\n  varia run scenes/default.json --out traj.csv --summary run.json");
+  add_scene(run, o.scene);
+  run->add_option("--out", o.run_out, "write the trajectory CSV here (t, q0.., p0.., observables)")
+      ->type_name("FILE.csv");
+  run->add_option("--summary", o.run_summary, "write the run record JSON here")->type_name("FILE.json");
+  run->add_flag("--quiet", o.run.quiet, "no progress line and no human summary");
+  run->callback([&] {
+    if (!o.run_out.empty()) o.run.out = o.run_out;
+    if (!o.run_summary.empty()) o.run.summary = o.run_summary;
+    chosen = [&] { return command_run(o.common, o.scene, o.run); };
+  });
+
+  auto* ld = subcommand(app, o, "ld",
+                        "Evaluate the scene's discrete Lagrangian L_d(q0, q1; h) and its derivatives D1 L_d, "
+                        "D2 L_d at one point.",
+                        "Example:\n  varia ld scenes/default.json --q0 1.3 --q1 1.25 --h 0.1 --json");
+  add_scene(ld, o.scene);
+  ld->add_option("--q0", o.ld.q0, "the first point, comma-separated")->required()->type_name("A,B,..");
+  ld->add_option("--q1", o.ld.q1, "the second point, comma-separated")->required()->type_name("C,D,..");
+  ld->add_option("--h", o.ld.h, "the step size")->required()->type_name("H");
+  ld->add_flag("--json", o.ld.json, "print {\"Ld\": x, \"D1\": [...], \"D2\": [...]}");
+  ld->callback([&] { chosen = [&] { return command_ld(o.common, o.scene, o.ld); }; });
+
+  auto* validate = subcommand(app, o, "validate",
+                              "Check a scene against the scene schema and the plugins' parameter schemas, "
+                              "and build its integrator, without running it.",
+                              "Example:\n  varia validate scenes/default.json");
+  add_scene(validate, o.scene);
+  validate->callback([&] { chosen = [&] { return command_validate(o.common, o.scene); }; });
+
+  auto* verify = subcommand(app, o, "verify",
+                            "Check the theorem properties of the scene's discrete Lagrangian and integrator "
+                            "(not available yet).",
+                            "Example:\n  varia verify scenes/default.json --json checks.json");
+  add_scene(verify, o.scene);
+  verify->add_option("--json", o.verify_json, "write the checks as JSON here")->type_name("FILE");
+  verify->callback([&] { chosen = not_available("verify"); });
+
+  auto* cost = subcommand(app, o, "cost",
+                          "What accuracy costs in time: error, work and time across step sizes and methods, "
+                          "as CSV and a plot (not available yet).",
+                          "Example:\n  varia cost scenes/pendulum-galerkin-s1.json scenes/pendulum-galerkin-s2.json "
+                          "--out cost/");
+  cost->add_option("SCENE", o.scenes, "scene files")->required()->type_name("SCENE.json");
+  cost->add_option("--out", o.cost_out, "write cost.csv and cost.svg in this directory")->type_name("DIR");
+  cost->callback([&] { chosen = not_available("cost"); });
+}
+
+// CLI11 reports a mistyped command as "A subcommand is required"; name it instead.
+bool known_command(const CLI::App& app, const std::string& word) {
+  const auto commands = app.get_subcommands([&](const CLI::App* sub) { return sub->get_name() == word; });
+  return !commands.empty();
+}
+
+std::string command_names(const CLI::App& app) {
+  std::string names;
+  for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; }))
+    names += (names.empty() ? "" : ", ") + sub->get_name();
+  return names;
+}
+
+}  // namespace
+
+int main_cli(int argc, char** argv) {
+  CLI::App app{"varia: variational integrators built from runtime-loaded plugins."};
+  app.set_version_flag("--version", VARIA_VERSION);
+  app.require_subcommand(1);
+  app.footer(
+      "Exit codes: 0 success, 2 bad input, 3 plugin fault, 4 numerical failure.\n"
+      "Plugins are searched in the bundled directory, then --plugin-path, then VARIA_PLUGIN_PATH.\n"
+      "Example:\n  varia run scenes/default.json --out traj.csv --summary run.json");
+  Options options;
+  Command chosen;
+  define_commands(app, options, chosen);
+  if (argc > 1 && argv[1][0] != '-' && !known_command(app, argv[1])) {
+    report(fmt::format("unknown command '{}'; the commands are: {}", argv[1], command_names(app)));
+    return kExitInput;
+  }
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help, --version
+    report(e.what());  // spec "Exit codes": a bad flag is bad input
+    return kExitInput;
+  }
+  return guarded(chosen);
+}
+
+}  // namespace varia::host

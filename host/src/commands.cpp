@@ -1,0 +1,174 @@
+#include "commands.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstdlib>
+
+#include "assemble.hpp"
+#include "output.hpp"
+#include "registry.hpp"
+#include "scene.hpp"
+
+namespace varia::host {
+
+using nlohmann::json;
+
+namespace {
+
+Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
+
+// Loads and assembles a scene; every InputError about it is prefixed with the scene's file name.
+struct Prepared {
+  Scene scene;
+  Assembly assembly;
+};
+
+Prepared prepare(const std::string& scene_file, Registry& registry) {
+  try {
+    Scene scene = load_scene(scene_file, registry);
+    Assembly assembly = assemble(scene, registry);
+    return Prepared{std::move(scene), std::move(assembly)};
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", scene_file, e.what()));
+  }
+}
+
+// ---- plugins -------------------------------------------------------------------------------------
+
+std::string plain(const json& value) { return value.is_string() ? value.get<std::string>() : value.dump(); }
+
+// "order=4, symmetric=true, group=SO(2)"
+std::string properties_text(const json& properties) {
+  std::vector<std::string> items;
+  if (properties.is_object())
+    for (const auto& [key, value] : properties.items()) items.push_back(key + "=" + plain(value));
+  return fmt::format("{}", fmt::join(items, ", "));
+}
+
+// "mass (default 1), length (default 1)", from the parameter schema's "properties".
+std::string parameters_text(const json& schema) {
+  std::vector<std::string> items;
+  if (schema.is_object() && schema.contains("properties") && schema["properties"].is_object())
+    for (const auto& [key, value] : schema["properties"].items())
+      items.push_back(value.is_object() && value.contains("default")
+                          ? fmt::format("{} (default {})", key, plain(value["default"]))
+                          : key);
+  return items.empty() ? "-" : fmt::format("{}", fmt::join(items, ", "));
+}
+
+// One line per plugin (kind, type, version, file), its parameters and properties indented below.
+void print_plugins_table(const std::vector<PluginRecord>& records, const std::vector<Refusal>& refused) {
+  std::size_t kind_width = 4, type_width = 4, version_width = 7;
+  for (const auto& r : records) {
+    kind_width = std::max(kind_width, r.kind.size());
+    type_width = std::max(type_width, r.type.size());
+    version_width = std::max(version_width, r.version.size());
+  }
+  const auto line = [&](const std::string& kind, const std::string& type, const std::string& version,
+                        const std::string& file) {
+    fmt::print("{:<{}}  {:<{}}  {:<{}}  {}\n", kind, kind_width, type, type_width, version, version_width, file);
+  };
+  line("KIND", "TYPE", "VERSION", "FILE");
+  const std::string indent(kind_width + 2, ' ');
+  for (const auto& r : records) {
+    line(r.kind, r.type, r.version, r.file.string());
+    fmt::print("{}parameters: {}\n", indent, parameters_text(r.parameter_schema));
+    if (const auto properties = properties_text(r.properties); !properties.empty())
+      fmt::print("{}properties: {}\n", indent, properties);
+  }
+  if (refused.empty()) return;
+  fmt::print("\nrefused:\n");
+  for (const auto& r : refused) fmt::print("  {}: {}\n", r.file.string(), r.reason);
+}
+
+nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records) {
+  auto array = nlohmann::ordered_json::array();
+  for (const auto& r : records)
+    array.push_back({{"kind", r.kind},
+                     {"type", r.type},
+                     {"version", r.version},
+                     {"file", r.file.string()},
+                     {"properties", r.properties},
+                     {"parameter_schema", r.parameter_schema}});
+  return array;
+}
+
+// ---- ld ------------------------------------------------------------------------------------------
+
+Eigen::VectorXd parse_numbers(const std::string& text, int expected, const char* flag) {
+  std::vector<double> values;
+  const char* cursor = text.c_str();
+  bool ok = !text.empty();
+  while (ok && *cursor != '\0') {
+    char* end = nullptr;
+    errno = 0;
+    values.push_back(std::strtod(cursor, &end));
+    ok = end != cursor && errno == 0 && std::isfinite(values.back()) && (*end == ',' || *end == '\0');
+    cursor = *end == ',' ? end + 1 : end;
+    if (ok && *end == ',' && *cursor == '\0') ok = false;  // a trailing comma
+  }
+  if (!ok || static_cast<int>(values.size()) != expected)
+    throw InputError(fmt::format("{}: expected {} comma-separated finite numbers; found '{}'", flag, expected, text));
+  return Eigen::Map<const Eigen::VectorXd>(values.data(), expected);
+}
+
+}  // namespace
+
+int command_plugins(const CommonOptions& common, bool as_json) {
+  Registry registry = make_registry(common);
+  std::vector<Refusal> refused;
+  const auto records = registry.list(refused);
+  if (!as_json) {
+    print_plugins_table(records, refused);
+    return 0;
+  }
+  fmt::print("{}\n", plugins_json(records).dump(2));
+  // With --json, stdout holds the array alone; refusals are diagnostics on stderr.
+  for (const auto& r : refused) fmt::print(stderr, "varia: refused {}: {}\n", r.file.string(), r.reason);
+  return 0;
+}
+
+int command_validate(const CommonOptions& common, const std::string& scene_file) {
+  Registry registry = make_registry(common);
+  const Prepared prepared = prepare(scene_file, registry);
+  fmt::print("{}: valid ({} with {} on {}, {} steps of {})\n", scene_file, prepared.scene.construction,
+             prepared.scene.lagrangian.type, prepared.scene.manifold.type, prepared.scene.steps,
+             prepared.scene.step);
+  return 0;
+}
+
+int command_run(const CommonOptions& common, const std::string& scene_file, const RunOptions& options) {
+  Registry registry = make_registry(common);
+  Prepared prepared = prepare(scene_file, registry);
+  run_scene(prepared.scene, prepared.assembly, registry, options);
+  return 0;
+}
+
+int command_ld(const CommonOptions& common, const std::string& scene_file, const LdOptions& options) {
+  Registry registry = make_registry(common);
+  Prepared prepared = prepare(scene_file, registry);
+  Assembly& a = prepared.assembly;
+  if (a.discrete_lagrangian == nullptr)
+    throw InputError(fmt::format("{}: /method/construction: construction '{}' has no discrete Lagrangian",
+                                 scene_file, prepared.scene.construction));
+  if (!(options.h > 0.0) || !std::isfinite(options.h))
+    throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
+  const Eigen::VectorXd q0 = parse_numbers(options.q0, a.map->point_size(), "--q0");
+  const Eigen::VectorXd q1 = parse_numbers(options.q1, a.map->point_size(), "--q1");
+  double ld = 0.0;
+  Eigen::VectorXd d1(a.map->dim()), d2(a.map->dim());
+  a.discrete_lagrangian->evaluate(q0.data(), q1.data(), options.h, &ld, d1.data(), d2.data());
+  if (options.json) {
+    const nlohmann::ordered_json result{{"Ld", ld}, {"D1", as_vector(d1)}, {"D2", as_vector(d2)}};
+    fmt::print("{}\n", result.dump());
+    return 0;
+  }
+  fmt::print("Ld = {}\nD1 = [{}]\nD2 = [{}]\n", ld, fmt::join(as_vector(d1), ", "),
+             fmt::join(as_vector(d2), ", "));
+  return 0;
+}
+
+}  // namespace varia::host

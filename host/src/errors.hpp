@@ -1,0 +1,29 @@
+// The host's error classes and the exit codes they map to (spec: "Exit codes").
+#pragma once
+
+#include <stdexcept>
+#include <string>
+
+namespace varia::host {
+
+// Bad input (exit code 2): the message names what was wrong and what was expected; for a scene
+// field, it starts with the field's JSON pointer.
+class InputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// A plugin that cannot be loaded or misbehaves (exit code 3): the message names the file.
+// (varia::PluginFault from core is the same exit code.)
+class PluginLoadError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Exit codes (spec: "Exit codes").
+inline constexpr int kExitOk = 0;
+inline constexpr int kExitInput = 2;
+inline constexpr int kExitPlugin = 3;
+inline constexpr int kExitNumerical = 4;
+
+}  // namespace varia::host

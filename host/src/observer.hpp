@@ -1,0 +1,42 @@
+// The observables a scene asks for (spec: "observe"): energy E = <p, v> - L with v from the
+// inverse Legendre transform, the Noether momentum J(q, v), and ||I - R^T R|| on SO3. Nothing
+// that is not asked for is computed.
+#pragma once
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "scene.hpp"
+#include "varia/core/lagrangian.hpp"
+#include "varia/core/mechanics.hpp"
+
+namespace varia::host {
+
+class Observer {
+ public:
+  // v0 is the initial velocity, the first warm start of the inverse Legendre transform.
+  Observer(const Observe& observe, Lagrangian& lagrangian, const Eigen::VectorXd& v0,
+           const SolverOptions& options);
+  std::vector<std::string> columns() const;  // energy; momentum0..; orthogonality
+  // Computes the observables at (q, p) into values() and updates the largest deviations from the
+  // first values seen.
+  void observe(const double* q, const double* p);
+  const std::vector<double>& values() const { return values_; }
+  double energy_error() const { return energy_error_; }
+  double momentum_error() const { return momentum_error_; }
+  double orthogonality_error() const { return orthogonality_error_; }
+
+ private:
+  void update_errors();
+  Observe what_;
+  Lagrangian& lagrangian_;
+  LagrangianEvaluator evaluator_;  // its own counters: observing does not count as the method's work
+  SolverOptions options_;
+  Eigen::VectorXd v_;
+  int momentum_size_ = 0;
+  std::vector<double> values_, initial_;
+  double energy_error_ = 0.0, momentum_error_ = 0.0, orthogonality_error_ = 0.0;
+};
+
+}  // namespace varia::host

@@ -1,0 +1,295 @@
+#include "registry.hpp"
+
+#include <dlfcn.h>
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <set>
+#include <string_view>
+#include <vector>  // boost/dll/library_info.hpp (Boost 1.74) uses std::vector without including it
+
+#include <boost/dll/library_info.hpp>
+#include <boost/dll/runtime_symbol_info.hpp>
+#include <boost/dll/shared_library.hpp>
+
+namespace fs = std::filesystem;
+
+namespace varia::host {
+
+namespace {
+
+constexpr std::string_view kMarkerPrefix = "varia_type_";
+
+// A candidate refused while loading; the registry adds the file name.
+struct Refused {
+  std::string reason;
+};
+
+std::string kind_name(Kind kind) {
+  switch (kind) {
+    case Kind::manifold: return "manifold";
+    case Kind::quadrature: return "quadrature";
+    case Kind::lagrangian: return "lagrangian";
+    case Kind::one_step: return "one_step";
+    case Kind::effect: return "effect";
+    case Kind::force: return "force";
+  }
+  return "unknown";
+}
+
+// "varia_type_<kind>__<type>" with '-' written as '_' in <type> (sdk/plugin.hpp).
+std::optional<Marker> parse_marker(std::string_view symbol) {
+  if (symbol.substr(0, kMarkerPrefix.size()) != kMarkerPrefix) return std::nullopt;
+  symbol.remove_prefix(kMarkerPrefix.size());
+  const auto split = symbol.find("__");
+  if (split == std::string_view::npos || split == 0 || split + 2 == symbol.size()) return std::nullopt;
+  Marker marker{std::string(symbol.substr(0, split)), std::string(symbol.substr(split + 2))};
+  std::replace(marker.type.begin(), marker.type.end(), '_', '-');
+  return marker;
+}
+
+// Each directory's *.so regular files, sorted; a missing directory contributes nothing.
+std::vector<fs::path> so_files(const fs::path& directory) {
+  std::vector<fs::path> files;
+  std::error_code ec;
+  if (!fs::is_directory(directory, ec)) return files;
+  for (fs::directory_iterator it(directory, ec), end; !ec && it != end; it.increment(ec)) {
+    std::error_code type_ec;
+    if (it->path().extension() == ".so" && it->is_regular_file(type_ec)) files.push_back(it->path());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+std::string dlopen_error(const fs::path& file) {
+  void* handle = ::dlopen(file.c_str(), RTLD_LAZY | RTLD_LOCAL);
+  if (handle != nullptr) {
+    ::dlclose(handle);
+    return "cannot be loaded";
+  }
+  const char* error = ::dlerror();
+  return error != nullptr ? error : "cannot be loaded";
+}
+
+nlohmann::json parse_metadata(const char* text, const char* what) {
+  try {
+    return nlohmann::json::parse(text);
+  } catch (const nlohmann::json::exception& e) {
+    throw Refused{fmt::format("malformed {} in varia_info: {}", what, e.what())};
+  }
+}
+
+// Deletes a plugin's object, then releases the object's hold on the library that made it.
+struct PluginDeleter {
+  std::shared_ptr<boost::dll::shared_library> library;
+  void operator()(PluginObject* object) {
+    delete object;
+    library.reset();
+  }
+};
+
+}  // namespace
+
+struct Registry::Loaded {
+  std::shared_ptr<boost::dll::shared_library> library;
+  sdk::CreateFunction* create = nullptr;
+  PluginRecord record;
+};
+
+namespace {
+
+std::shared_ptr<boost::dll::shared_library> open_library(const fs::path& file) {
+  auto library = std::make_shared<boost::dll::shared_library>();
+  boost::dll::fs::error_code ec;
+  library->load(file, ec, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local);
+  if (ec) throw Refused{"not a loadable shared library: " + dlopen_error(file)};
+  return library;
+}
+
+// The ABI check comes before anything else is imported (Boost.DLL, doc/missuses.qbk).
+void check_abi(const boost::dll::shared_library& library) {
+  if (!library.has("varia_abi_version"))
+    throw Refused{"not a varia plugin (no varia_abi_version symbol)"};
+  const int version = library.get<const int>("varia_abi_version");
+  if (version != kAbiVersion)
+    throw Refused{fmt::format("ABI version {}, this host speaks {}", version, kAbiVersion)};
+}
+
+PluginRecord read_info(const boost::dll::shared_library& library, const fs::path& file) {
+  if (!library.has("varia_info")) throw Refused{"missing metadata (no varia_info)"};
+  const sdk::PluginInfo* info = library.get_alias<sdk::InfoFunction>("varia_info")();
+  if (info == nullptr || info->kind == nullptr || info->type == nullptr ||
+      info->version == nullptr || info->parameter_schema == nullptr || info->properties == nullptr)
+    throw Refused{"missing metadata (varia_info has an empty field)"};
+  return PluginRecord{file, info->kind, info->type, info->version,
+                      parse_metadata(info->parameter_schema, "parameter_schema"),
+                      parse_metadata(info->properties, "properties")};
+}
+
+}  // namespace
+
+std::shared_ptr<Registry::Loaded> Registry::load(const fs::path& file, const SymbolScan& scan) {
+  try {
+    if (!scan.parsed) throw Refused{"not a shared library (its format cannot be read)"};
+    auto loaded = std::make_shared<Loaded>();
+    loaded->library = open_library(file);
+    check_abi(*loaded->library);
+    loaded->record = read_info(*loaded->library, file);
+    const auto& record = loaded->record;
+    const bool declared = std::any_of(scan.markers.begin(), scan.markers.end(), [&](const Marker& m) {
+      return m.kind == record.kind && m.type == record.type;
+    });
+    if (scan.has_symbol_table && !declared)
+      throw Refused{fmt::format("varia_info says {} '{}' but no matching varia_type_ marker is exported",
+                                record.kind, record.type)};
+    if (!loaded->library->has("varia_create")) throw Refused{"no varia_create factory"};
+    loaded->create = &loaded->library->get_alias<sdk::CreateFunction>("varia_create");
+    return loaded;
+  } catch (const Refused& refused) {
+    throw PluginLoadError(fmt::format("{}: {}", file.string(), refused.reason));
+  } catch (const std::exception& e) {  // boost::dll reading a symbol
+    throw PluginLoadError(fmt::format("{}: {}", file.string(), e.what()));
+  }
+}
+
+std::vector<fs::path> Registry::search_path(const std::vector<std::string>& plugin_paths) {
+  // Spec "Build layout": bundled plugins, then --plugin-path, then VARIA_PLUGIN_PATH.
+  std::vector<fs::path> directories{
+      (boost::dll::program_location().parent_path() / ".." / "lib" / "varia" / "plugins")
+          .lexically_normal()};
+  for (const auto& path : plugin_paths) directories.emplace_back(path);
+  if (const char* env = std::getenv("VARIA_PLUGIN_PATH")) {
+    std::string_view rest(env);
+    while (!rest.empty()) {
+      const auto colon = rest.find(':');
+      const auto entry = rest.substr(0, colon);
+      if (!entry.empty()) directories.emplace_back(std::string(entry));
+      rest = colon == std::string_view::npos ? std::string_view() : rest.substr(colon + 1);
+    }
+  }
+  return directories;
+}
+
+Registry::Registry(std::vector<fs::path> directories) : directories_(std::move(directories)) {}
+Registry::~Registry() = default;
+
+const std::vector<fs::path>& Registry::candidates() {
+  if (candidates_) return *candidates_;
+  candidates_.emplace();
+  std::set<fs::path> seen;  // a directory named twice must not make its plugins duplicates
+  for (const auto& directory : directories_)
+    for (auto& file : so_files(directory)) {
+      std::error_code ec;
+      auto canonical = fs::weakly_canonical(file, ec);
+      if (seen.insert(ec ? file : canonical).second) candidates_->push_back(std::move(file));
+    }
+  return *candidates_;
+}
+
+const SymbolScan& Registry::scan(const fs::path& file) {
+  auto [it, inserted] = scans_.try_emplace(file);
+  if (!inserted) return it->second;
+  SymbolScan& result = it->second;
+  try {
+    boost::dll::library_info info(file, false);
+    const auto symbols = info.symbols();
+    result.parsed = true;
+    result.has_symbol_table = !symbols.empty();
+    for (const auto& symbol : symbols)
+      if (auto marker = parse_marker(symbol)) result.markers.push_back(std::move(*marker));
+  } catch (const std::exception&) {
+    result.parsed = false;  // reported by list(); find() skips it
+  }
+  return result;
+}
+
+std::vector<fs::path> Registry::files_declaring(const std::string& kind, const std::string& type) {
+  std::vector<fs::path> files;
+  for (const auto& file : candidates()) {
+    const SymbolScan& s = scan(file);
+    if (!s.parsed) continue;
+    const bool declares = std::any_of(s.markers.begin(), s.markers.end(), [&](const Marker& m) {
+      return m.kind == kind && m.type == type;
+    });
+    if (declares) {
+      files.push_back(file);
+    } else if (!s.has_symbol_table) {  // stripped: only its metadata can tell
+      try {
+        const auto loaded = load(file, s);
+        if (loaded->record.kind == kind && loaded->record.type == type) files.push_back(file);
+      } catch (const PluginLoadError&) {
+      }
+    }
+  }
+  return files;
+}
+
+std::string Registry::valid_types(const std::string& kind) {
+  std::set<std::string> types;
+  for (const auto& file : candidates())
+    for (const auto& marker : scan(file).markers)
+      if (marker.kind == kind) types.insert(marker.type);
+  if (types.empty()) {
+    std::vector<std::string> directories;
+    for (const auto& d : directories_) directories.push_back(d.string());
+    return fmt::format("no {} plugins were found in: {}", kind, fmt::join(directories, ", "));
+  }
+  return fmt::format("valid {} types are: {}", kind, fmt::join(types, ", "));
+}
+
+const PluginRecord& Registry::find(const std::string& kind, const std::string& type) {
+  const std::string key = kind + "/" + type;
+  if (const auto it = loaded_.find(key); it != loaded_.end()) return it->second->record;
+  const auto files = files_declaring(kind, type);
+  if (files.empty()) throw InputError(fmt::format("unknown {} type '{}'; {}", kind, type, valid_types(kind)));
+  if (files.size() > 1)
+    throw PluginLoadError(fmt::format("{} type '{}' is provided by two files: {} and {}", kind, type,
+                                      files[0].string(), files[1].string()));
+  auto loaded = load(files[0], scan(files[0]));
+  const PluginRecord& record = loaded->record;
+  if (record.kind != kind || record.type != type)
+    throw PluginLoadError(fmt::format("{}: declares {} '{}' in varia_info, not {} '{}'",
+                                      files[0].string(), record.kind, record.type, kind, type));
+  load_order_.push_back(type);
+  return loaded_.emplace(key, std::move(loaded)).first->second->record;
+}
+
+std::shared_ptr<PluginObject> Registry::create(const std::string& kind, const std::string& type,
+                                               const nlohmann::json& parameters,
+                                               const sdk::Context& context) {
+  const PluginRecord& record = find(kind, type);
+  const Loaded& loaded = *loaded_.at(kind + "/" + type);
+  const std::string parameter_text = parameters.dump();
+  const std::string context_text =
+      nlohmann::json{{"manifold", context.manifold}, {"point_size", context.point_size}, {"dim", context.dim}}
+          .dump();
+  char error[1024] = {};
+  PluginObject* object = loaded.create(parameter_text.c_str(), context_text.c_str(), error, sizeof error);
+  if (object == nullptr)
+    throw PluginLoadError(fmt::format("{}: {}: {}", record.file.string(), type,
+                                      error[0] != '\0' ? error : "the plugin made no object"));
+  std::shared_ptr<PluginObject> owned(object, PluginDeleter{loaded.library});
+  if (kind_name(owned->kind()) != kind)
+    throw PluginLoadError(fmt::format("{}: {}: made an object of kind {}, not {}", record.file.string(),
+                                      type, kind_name(owned->kind()), kind));
+  return owned;
+}
+
+std::vector<PluginRecord> Registry::list(std::vector<Refusal>& refused) {
+  std::vector<PluginRecord> records;
+  for (const auto& file : candidates()) {
+    try {
+      records.push_back(load(file, scan(file))->record);
+    } catch (const PluginLoadError& e) {
+      // The message is "<file>: <reason>"; a Refusal keeps them apart.
+      refused.push_back(Refusal{file, std::string(e.what()).substr(file.string().size() + 2)});
+    }
+  }
+  return records;
+}
+
+std::vector<std::string> Registry::loaded() const { return load_order_; }
+
+}  // namespace varia::host

@@ -1,0 +1,189 @@
+#include "run.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <memory>
+
+#include "observer.hpp"
+#include "output.hpp"
+#include "registry.hpp"
+
+namespace varia::host {
+
+using json = nlohmann::ordered_json;
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+// A progress line on stderr, only when stderr is a terminal (spec: "Progress and diagnostics").
+class Progress {
+ public:
+  Progress(long steps, bool quiet) : steps_(steps), active_(!quiet && ::isatty(STDERR_FILENO)) {}
+  ~Progress() {
+    if (active_ && shown_) std::fputs("\r\033[K", stderr);
+  }
+  void update(long step) {
+    if (!active_) return;
+    const auto now = Clock::now();
+    if (shown_ && now - last_ < std::chrono::milliseconds(200)) return;
+    last_ = now;
+    shown_ = true;
+    std::fprintf(stderr, "\rvaria: step %ld of %ld (%.0f%%)", step, steps_, 100.0 * step / steps_);
+    std::fflush(stderr);
+  }
+
+ private:
+  long steps_;
+  bool active_, shown_ = false;
+  Clock::time_point last_;
+};
+
+std::vector<std::string> csv_columns(int point_size, int dim, const Observer& observer) {
+  std::vector<std::string> columns{"t"};
+  for (int i = 0; i < point_size; ++i) columns.push_back(fmt::format("q{}", i));
+  for (int i = 0; i < dim; ++i) columns.push_back(fmt::format("p{}", i));
+  for (auto& name : observer.columns()) columns.push_back(std::move(name));
+  return columns;
+}
+
+// The state of a run as it goes, and what the run record reports.
+struct Trajectory {
+  Eigen::VectorXd q, p, q1, p1;
+  long step = 0;  // steps completed
+  double t = 0.0;
+  double wall_seconds = 0.0;
+};
+
+struct Failure {
+  long step;  // the step that failed: from step - 1 to step
+  double t;   // the time it started from
+  double residual;
+  std::string message;
+};
+
+bool finite(const Eigen::VectorXd& x) { return x.allFinite(); }
+
+// Spec "Outputs": the run record's keys.
+json run_record(const Scene& scene, const Assembly& a, const Observer& observer, const Trajectory& state,
+                const Registry& registry) {
+  const auto& statistics = a.map->solver_statistics();
+  const auto& evaluations = a.map->evaluations();
+  json record{
+      {"steps", state.step},
+      {"wall_seconds", state.wall_seconds},
+      {"newton_iterations", {{"mean", statistics.mean()}, {"max", statistics.max_iterations}}},
+      {"evaluations",
+       {{"lagrangian", evaluations.lagrangian}, {"gradient", evaluations.gradient}, {"hessian", evaluations.hessian}}},
+      {"final", {{"t", state.t}, {"q", as_vector(state.q)}, {"p", as_vector(state.p)}}},
+  };
+  if (scene.observe.energy) record["energy_error_max"] = observer.energy_error();
+  if (scene.observe.momentum) record["momentum_error_max"] = observer.momentum_error();
+  if (scene.observe.orthogonality) record["orthogonality_error_max"] = observer.orthogonality_error();
+  record["plugins_loaded"] = registry.loaded();
+  return record;
+}
+
+void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, const Observer& observer,
+                         const Trajectory& state) {
+  const auto& statistics = a.map->solver_statistics();
+  fmt::print(to, "steps             {}\n", state.step);
+  fmt::print(to, "final time        {:.10g}\n", state.t);
+  if (scene.observe.energy) fmt::print(to, "energy error max  {:.3e}\n", observer.energy_error());
+  if (scene.observe.momentum) fmt::print(to, "momentum error    {:.3e}\n", observer.momentum_error());
+  if (scene.observe.orthogonality) fmt::print(to, "orthogonality     {:.3e}\n", observer.orthogonality_error());
+  fmt::print(to, "Newton iterations mean {:.2f}, max {}\n", statistics.mean(), statistics.max_iterations);
+  fmt::print(to, "wall time         {:.4f} s\n", state.wall_seconds);
+}
+
+class Stepper {
+ public:
+  Stepper(const Scene& scene, Assembly& a, const RunOptions& options)
+      : scene_(scene), a_(a), observer_(scene.observe, *a.lagrangian, a.v0, scene.solver) {
+    state_.q = a.q0;
+    state_.p = a.p0;
+    state_.q1.resize(a.q0.size());
+    state_.p1.resize(a.p0.size());
+    if (options.out) csv_ = std::make_unique<CsvWriter>(*options.out);
+  }
+
+  // Runs every step; returns the failure that stopped it, if any.
+  std::optional<Failure> run(bool quiet) {
+    Progress progress(scene_.steps, quiet);
+    const auto start = Clock::now();
+    std::optional<Failure> failure;
+    try {
+      start_output();
+      while (state_.step < scene_.steps) {
+        advance();
+        progress.update(state_.step);
+      }
+    } catch (const NumericalFailure& e) {
+      failure = Failure{state_.step + 1, state_.t, e.residual(), e.what()};
+    }
+    state_.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    if (csv_) csv_->flush();
+    return failure;
+  }
+
+  const Trajectory& state() const { return state_; }
+  const Observer& observer() const { return observer_; }
+
+ private:
+  void start_output() {
+    if (csv_) csv_->header(csv_columns(a_.map->point_size(), a_.map->dim(), observer_));
+    observe_and_write();
+  }
+
+  void advance() {
+    a_.map->step(state_.q.data(), state_.p.data(), scene_.step, state_.q1.data(), state_.p1.data());
+    if (!finite(state_.q1) || !finite(state_.p1)) throw NumericalFailure("a non-finite state", std::nan(""));
+    state_.q.swap(state_.q1);
+    state_.p.swap(state_.p1);
+    ++state_.step;
+    state_.t = state_.step * scene_.step;
+    observe_and_write();
+  }
+
+  // Spec "output.every": every k-th step; step 0 and the last step are always written.
+  void observe_and_write() {
+    observer_.observe(state_.q.data(), state_.p.data());
+    const bool due = state_.step % scene_.output_every == 0 || state_.step == scene_.steps;
+    if (csv_ && due)
+      csv_->row(state_.t, state_.q.data(), static_cast<int>(state_.q.size()), state_.p.data(),
+                static_cast<int>(state_.p.size()), observer_.values());
+  }
+
+  const Scene& scene_;
+  Assembly& a_;
+  Observer observer_;
+  Trajectory state_;
+  std::unique_ptr<CsvWriter> csv_;
+};
+
+}  // namespace
+
+void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options) {
+  Stepper stepper(scene, assembly, options);
+  const auto failure = stepper.run(options.quiet);
+  json record = run_record(scene, assembly, stepper.observer(), stepper.state(), registry);
+  if (failure)
+    record["failure"] = {{"step", failure->step},
+                         {"t", failure->t},
+                         {"residual", failure->residual},
+                         {"message", failure->message}};
+  if (options.summary) write_json_file(*options.summary, record);
+  if (failure)
+    throw NumericalFailure(fmt::format("step {} (from t = {:.10g}) failed: {}; residual {:.3e}", failure->step,
+                                       failure->t, failure->message, failure->residual),
+                           failure->residual);
+  // With the trajectory on stdout, the human summary goes to stderr.
+  if (!options.quiet) print_human_summary(options.out && *options.out == "-" ? stderr : stdout, scene, assembly,
+                                          stepper.observer(), stepper.state());
+}
+
+}  // namespace varia::host

@@ -1,0 +1,26 @@
+// `varia run`: the stepping loop, the trajectory CSV and the run record (spec: "Outputs").
+#pragma once
+
+#include <filesystem>
+#include <optional>
+#include <vector>
+
+#include "assemble.hpp"
+#include "scene.hpp"
+
+namespace varia::host {
+
+class Registry;
+
+struct RunOptions {
+  std::optional<std::filesystem::path> out;      // trajectory CSV ("-": stdout); none: not written
+  std::optional<std::filesystem::path> summary;  // run record JSON
+  bool quiet = false;                             // no progress line, no human summary
+};
+
+// Steps the scene's integrator to its last step. On a NumericalFailure the rows written so far
+// stay whole, the run record is written with a "failure" key, and a NumericalFailure naming the
+// step index, time and residual is thrown.
+void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options);
+
+}  // namespace varia::host

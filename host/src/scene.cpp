@@ -1,0 +1,199 @@
+#include "scene.hpp"
+
+#include <fmt/format.h>
+
+#include <cerrno>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+
+#include "json_schema.hpp"
+#include "registry.hpp"
+#include "scene_schema.hpp"
+
+namespace varia::host {
+
+using nlohmann::json;
+
+namespace {
+
+// The line and column (1-based) of a byte offset in a text.
+std::pair<std::size_t, std::size_t> line_and_column(const std::string& text, std::size_t byte) {
+  std::size_t line = 1, column = 1;
+  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      column = 1;
+    } else {
+      ++column;
+    }
+  }
+  return {line, column};
+}
+
+// nlohmann's message without its "[json.exception...] parse error at line L, column C: " head.
+std::string parse_error_reason(const std::string& what) {
+  const auto column = what.find("column ");
+  const auto colon = column == std::string::npos ? std::string::npos : what.find(": ", column);
+  return colon == std::string::npos ? what : what.substr(colon + 2);
+}
+
+const SchemaValidator& scene_validator() {
+  static const SchemaValidator validator(json::parse(kSceneSchema));
+  return validator;
+}
+
+PluginSpec plugin_spec(const json& object, std::string pointer, std::string kind) {
+  PluginSpec spec{std::move(pointer), std::move(kind), object.at("type").get<std::string>(), object};
+  spec.parameters.erase("type");
+  return spec;
+}
+
+std::optional<PluginSpec> optional_plugin(const json& method, const char* key, const char* kind) {
+  if (!method.contains(key)) return std::nullopt;
+  return plugin_spec(method[key], std::string("/method/") + key, kind);
+}
+
+// Spec: "step is h; exactly one of t_end or steps". t_end must be a whole number of steps.
+long steps_of(const json& document, double step) {
+  if (document.contains("steps")) return document["steps"].get<long>();
+  const double t_end = document["t_end"].get<double>();
+  const double ratio = t_end / step;
+  constexpr double kMaxSteps = 1e12;
+  if (ratio > kMaxSteps)
+    throw InputError(fmt::format("/t_end: expected at most {:g} steps; t_end / step is {:g}", kMaxSteps, ratio));
+  const long steps = std::lround(ratio);
+  if (steps < 1 || std::abs(steps * step - t_end) > 1e-9 * std::max(1.0, t_end))
+    throw InputError(fmt::format(
+        "/t_end: expected a whole number of steps of {} (t_end / step = {:.17g}); found {}", step, ratio, t_end));
+  return steps;
+}
+
+// Spec: s+1 control points at times 0 = d_0 < ... < d_s = 1.
+void check_control_times(const std::vector<double>& times, int degree) {
+  bool ok = static_cast<int>(times.size()) == degree + 1 && times.front() == 0.0 && times.back() == 1.0;
+  for (std::size_t i = 1; ok && i < times.size(); ++i) ok = times[i - 1] < times[i];
+  if (!ok)
+    throw InputError(fmt::format(
+        "/method/control_times: expected degree + 1 = {} increasing numbers from 0 to 1; found {}", degree + 1,
+        brief(json(times))));
+}
+
+void read_method(const json& method, Scene& scene) {
+  scene.construction = method["construction"].get<std::string>();
+  scene.quadrature = optional_plugin(method, "quadrature", "quadrature");
+  scene.one_step = optional_plugin(method, "one_step", "one_step");
+  scene.degree = method.value("degree", 0);
+  scene.form = method.value("form", scene.form);
+  if (method.contains("control_times")) {
+    scene.control_times = method["control_times"].get<std::vector<double>>();
+    check_control_times(*scene.control_times, scene.degree);
+  }
+  if (!method.contains("solver")) return;
+  const json& solver = method["solver"];
+  if (solver.is_string()) {
+    scene.group_solver = solver.get<std::string>();
+    return;
+  }
+  scene.solver.tolerance = solver.value("tolerance", scene.solver.tolerance);
+  scene.solver.max_iterations = solver.value("max_iterations", scene.solver.max_iterations);
+}
+
+void read_observe(const json& document, Scene& scene) {
+  for (const auto& name : document.value("observe", json::array())) {
+    if (name == "energy") scene.observe.energy = true;
+    if (name == "momentum") scene.observe.momentum = true;
+    if (name == "orthogonality") scene.observe.orthogonality = true;
+  }
+}
+
+void check_size(const std::vector<double>& values, int expected, const std::string& pointer,
+                const std::string& what) {
+  if (static_cast<int>(values.size()) != expected)
+    throw InputError(fmt::format("{}: expected {} number{} ({}); found {}", pointer, expected,
+                                 expected == 1 ? "" : "s", what, values.size()));
+}
+
+}  // namespace
+
+std::vector<const PluginSpec*> Scene::plugins() const {
+  std::vector<const PluginSpec*> all{&manifold, &lagrangian};
+  for (const auto& force : forces) all.push_back(&force);
+  if (quadrature) all.push_back(&*quadrature);
+  if (one_step) all.push_back(&*one_step);
+  return all;
+}
+
+json read_json_file(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  if (!in) throw InputError(fmt::format("cannot be read: {}", std::strerror(errno)));
+  std::ostringstream text;
+  text << in.rdbuf();
+  const std::string content = text.str();
+  try {
+    return json::parse(content);
+  } catch (const json::parse_error& e) {
+    const auto [line, column] = line_and_column(content, e.byte > 0 ? e.byte - 1 : 0);
+    throw InputError(
+        fmt::format("invalid JSON at line {}, column {}: {}", line, column, parse_error_reason(e.what())));
+  }
+}
+
+Scene parse_scene(const json& document) {
+  scene_validator().validate(document, "");
+  Scene scene;
+  const json& system = document["system"];
+  scene.manifold = plugin_spec(system["manifold"], "/system/manifold", "manifold");
+  scene.lagrangian = plugin_spec(system["lagrangian"], "/system/lagrangian", "lagrangian");
+  const json forces = system.value("forces", json::array());
+  for (std::size_t i = 0; i < forces.size(); ++i)
+    scene.forces.push_back(plugin_spec(forces[i], fmt::format("/system/forces/{}", i), "force"));
+  read_method(document["method"], scene);
+  scene.step = document["step"].get<double>();
+  scene.steps = steps_of(document, scene.step);
+  read_observe(document, scene);
+  if (document.contains("output")) scene.output_every = document["output"].value("every", 1);
+  const json& initial = document["initial"];
+  scene.q = initial["q"].get<std::vector<double>>();
+  if (initial.contains("p")) scene.p = initial["p"].get<std::vector<double>>();
+  if (initial.contains("v")) scene.v = initial["v"].get<std::vector<double>>();
+  return scene;
+}
+
+void validate_parameters(const Scene& scene, Registry& registry) {
+  for (const PluginSpec* spec : scene.plugins()) {
+    const PluginRecord* record = nullptr;
+    try {
+      record = &registry.find(spec->kind, spec->type);
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("{}/type: {}", spec->pointer, e.what()));
+    }
+    std::optional<SchemaValidator> validator;
+    try {
+      validator.emplace(record->parameter_schema);
+    } catch (const std::invalid_argument& e) {
+      throw PluginLoadError(fmt::format("{}: parameter_schema: {}", record->file.string(), e.what()));
+    }
+    validator->validate(spec->parameters, spec->pointer);
+  }
+}
+
+Scene load_scene(const std::filesystem::path& file, Registry& registry) {
+  Scene scene = parse_scene(read_json_file(file));
+  validate_parameters(scene, registry);
+  return scene;
+}
+
+void check_initial_state(const Scene& scene, Manifold& manifold, const std::string& manifold_type) {
+  const int point_size = manifold.point_size(), dim = manifold.dim();
+  check_size(scene.q, point_size, "/initial/q", fmt::format("the point size of {}", manifold_type));
+  if (scene.p) check_size(*scene.p, dim, "/initial/p", fmt::format("the dimension of {}", manifold_type));
+  if (scene.v) check_size(*scene.v, dim, "/initial/v", fmt::format("the dimension of {}", manifold_type));
+  char why[256] = {};
+  if (!manifold.contains(scene.q.data(), why, sizeof why))
+    throw InputError(fmt::format("/initial/q: expected a point of {}{}{}; found {}", manifold_type,
+                                 why[0] ? ": " : "", why, brief(json(scene.q))));
+}
+
+}  // namespace varia::host

@@ -1,0 +1,64 @@
+// Scenes (spec: "Scene files (JSON)"): reading, validation against schemas/scene.schema.json
+// (embedded in the program) and against each plugin's parameter schema, and the parsed content.
+#pragma once
+
+#include <filesystem>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/manifold.hpp"
+
+namespace varia::host {
+
+class Registry;
+
+// A JSON object with a "type" key: a plugin of the kind its place in the scene asks for.
+struct PluginSpec {
+  std::string pointer;        // where it is in the scene, e.g. "/system/lagrangian"
+  std::string kind;           // registry kind, e.g. "lagrangian"
+  std::string type;           // e.g. "pendulum"
+  nlohmann::json parameters;  // the object's keys minus "type"
+};
+
+struct Observe {
+  bool energy = false, momentum = false, orthogonality = false;
+};
+
+struct Scene {
+  std::string construction;  // galerkin | shooting | one-step | lie-verlet
+  PluginSpec manifold, lagrangian;
+  std::vector<PluginSpec> forces;
+  std::optional<PluginSpec> quadrature, one_step;
+  int degree = 0;                                    // galerkin
+  std::optional<std::vector<double>> control_times;  // galerkin, checked against degree
+  std::string form = "lagrangian";                   // shooting
+  std::string group_solver = "cayley";               // lie-verlet
+  SolverOptions solver;
+  double step = 0.0;
+  long steps = 0;  // given, or round(t_end / step)
+  Observe observe;
+  int output_every = 1;
+  std::vector<double> q;
+  std::optional<std::vector<double>> p, v;  // exactly one is set
+
+  // Every plugin object of the scene, in the order they are created.
+  std::vector<const PluginSpec*> plugins() const;
+};
+
+// Reads a JSON file; a syntax error is an InputError naming its line and column. Messages do
+// not repeat the file name: the caller prefixes it.
+nlohmann::json read_json_file(const std::filesystem::path& file);
+// Checks a scene document against the scene schema and returns its content (InputError).
+Scene parse_scene(const nlohmann::json& document);
+// Checks each plugin object's parameters against its plugin's parameter schema; an unknown type
+// is an InputError naming the object's "type" pointer.
+void validate_parameters(const Scene& scene, Registry& registry);
+// read_json_file + parse_scene + validate_parameters.
+Scene load_scene(const std::filesystem::path& file, Registry& registry);
+// Checks initial.q/p/v against the manifold (sizes, contains); InputError naming /initial/...
+void check_initial_state(const Scene& scene, Manifold& manifold, const std::string& manifold_type);
+
+}  // namespace varia::host

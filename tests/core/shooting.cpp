@@ -1,0 +1,362 @@
+// The shooting-based discrete Lagrangian (paper, sec. 3): orders min(p, q) measured against exact
+// solutions, the Hamiltonian and Type II forms, exact derivatives, the shooting Newton iteration.
+#include "varia/core/shooting.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "core/shooting_fixtures.hpp"
+#include "varia/core/one_step_map.hpp"
+
+using namespace varia;
+using namespace varia::testing;
+
+namespace {
+
+constexpr double kTime = 4.0;  // the final time of the convergence runs
+const std::vector<int> kSteps{10, 20, 40, 80, 160};
+
+std::vector<double> step_sizes() {
+  std::vector<double> h;
+  for (int n : kSteps) h.push_back(kTime / n);
+  return h;
+}
+
+// The oscillator's exact state at kTime from (q0, p0) = (1, 0.5): q0 cos t + p0 sin t.
+Eigen::Vector2d oscillator_exact() {
+  return {std::cos(kTime) + 0.5 * std::sin(kTime), -std::sin(kTime) + 0.5 * std::cos(kTime)};
+}
+
+// The pendulum's state at kTime from (1, 0.5), converged: 4000 steps of the 3-stage Gauss
+// method (order 6, error ~1e-17).
+Eigen::Vector2d pendulum_reference() {
+  FlatSpace space(1);
+  SeparablePendulum pendulum;
+  auto gauss = gauss3();
+  OneStepHamiltonianMap map(space, pendulum, gauss, {});
+  return run(map, Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Constant(1, 0.5),
+             kTime / 4000, 4000);
+}
+
+// Global errors at kTime (max norm over q and p) of a map made per step size.
+template <class Map>
+std::vector<double> errors(Map&& make_and_run, const Eigen::Vector2d& reference) {
+  std::vector<double> e;
+  for (int n : kSteps) e.push_back((make_and_run(kTime / n, n) - reference).template lpNorm<Eigen::Infinity>());
+  return e;
+}
+
+// The global errors of the shooting construction on a 1-dof Lagrangian from (1, 0.5).
+std::vector<double> shooting_errors(Lagrangian& lagrangian, Quadrature& rule,
+                                    OneStepMethod& method, ShootingForm form,
+                                    const Eigen::Vector2d& reference) {
+  return errors(
+      [&](double h, int n) {
+        FlatSpace space(1);
+        ShootingDiscreteLagrangian shooting(space, lagrangian, rule, method, form, {});
+        return run(shooting, Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Constant(1, 0.5),
+                   h, n);
+      },
+      reference);
+}
+
+// Fits the slope over all five step sizes but the coarsest (h = 0.4, pre-asymptotic), unless
+// the finest has reached round-off (then it is dropped too).
+double order_of(const std::vector<double>& e) {
+  const int last = e.back() < 1e-12 ? 4 : 5;
+  return fitted_order(step_sizes(), e, 1, last);
+}
+
+}  // namespace
+
+TEST_CASE("SVIMID (implicit midpoint + trapezoid) is order 2 on the pendulum") {
+  SeparablePendulum pendulum;
+  auto rule = trapezoid();
+  auto method = implicit_midpoint();
+  const auto e = shooting_errors(pendulum, rule, method, ShootingForm::lagrangian,
+                                 pendulum_reference());
+  CAPTURE(e[4]);
+  const double order = order_of(e);
+  CAPTURE(order);
+  CHECK(order == doctest::Approx(2.0).epsilon(0.05));
+}
+
+TEST_CASE("SVIRK4 (rk4 + simpson) is order 4 on the pendulum") {
+  SeparablePendulum pendulum;
+  auto rule = simpson();
+  auto method = rk4();
+  const auto e = shooting_errors(pendulum, rule, method, ShootingForm::lagrangian,
+                                 pendulum_reference());
+  CAPTURE(e[4]);
+  const double order = order_of(e);
+  CAPTURE(order);
+  CHECK(order == doctest::Approx(4.0).epsilon(0.05));
+}
+
+TEST_CASE("sviRK4EM (rk4 + two-term Euler-Maclaurin) is order 4 on the oscillator") {
+  MassOscillator oscillator;
+  EulerMaclaurin2 rule;
+  auto method = rk4();
+  const auto e = shooting_errors(oscillator, rule, method, ShootingForm::lagrangian,
+                                 oscillator_exact());
+  CAPTURE(e[4]);
+  const double order = order_of(e);
+  CAPTURE(order);
+  CHECK(order == doctest::Approx(4.0).epsilon(0.05));
+}
+
+TEST_CASE("shooting order is min(p, q) when the method and the rule differ in order") {
+  SeparablePendulum pendulum;
+  const Eigen::Vector2d reference = pendulum_reference();
+  struct Pair {
+    const char* name;
+    OneStepMethod* method;
+    Quadrature* rule;
+    double order;
+  };
+  auto rk = rk4();
+  auto em = explicit_midpoint();
+  auto g2 = gauss2();
+  auto trap = trapezoid();
+  auto simp = simpson();
+  auto mid = midpoint_rule();
+  const Pair pairs[] = {{"rk4 + trapezoid", &rk, &trap, 2},
+                        {"explicit-midpoint + simpson", &em, &simp, 2},
+                        {"gauss-2 + midpoint rule", &g2, &mid, 2},
+                        {"gauss-2 + simpson (SRK4 order)", &g2, &simp, 4}};
+  for (const Pair& pair : pairs) {
+    const auto e = shooting_errors(pendulum, *pair.rule, *pair.method, ShootingForm::lagrangian,
+                                   reference);
+    const double order = order_of(e);
+    CAPTURE(pair.name);
+    CAPTURE(order);
+    CHECK(order == doctest::Approx(pair.order).epsilon(0.05));
+  }
+}
+
+TEST_CASE("Hamiltonian and Type II forms have the method's order and agree with the Lagrangian form") {
+  MassOscillator oscillator;
+  auto rule = simpson();
+  auto method = rk4();
+  const Eigen::Vector2d exact = oscillator_exact();
+  const auto lagrangian = shooting_errors(oscillator, rule, method, ShootingForm::lagrangian, exact);
+  for (ShootingForm form : {ShootingForm::hamiltonian, ShootingForm::type_2}) {
+    const auto e = shooting_errors(oscillator, rule, method, form, exact);
+    const double order = order_of(e);
+    CAPTURE(static_cast<int>(form));
+    CAPTURE(order);
+    CHECK(order == doctest::Approx(4.0).epsilon(0.05));
+    // Both errors are O(h^4), so the forms agree to O(h^4): within a factor of the Lagrangian's.
+    for (std::size_t i = 0; i < e.size(); ++i) CHECK(e[i] <= 2.0 * lagrangian[i] + 1e-13);
+  }
+}
+
+TEST_CASE("the step solves the IDEL equations p0 = -D1 L_d, p1 = D2 L_d of evaluate, in every form") {
+  SeparablePendulum pendulum;
+  auto rule = simpson();
+  auto method = gauss2();
+  FlatSpace space(1);
+  for (ShootingForm form : {ShootingForm::lagrangian, ShootingForm::hamiltonian,
+                            ShootingForm::type_2}) {
+    CAPTURE(static_cast<int>(form));
+    ShootingDiscreteLagrangian shooting(space, pendulum, rule, method, form, {});
+    const double q0 = 0.7, p0 = -0.3, h = 0.3;
+    double q1, p1, Ld, D1, D2;
+    shooting.step(&q0, &p0, h, &q1, &p1);
+    shooting.evaluate(&q0, &q1, h, &Ld, &D1, &D2);
+    CHECK(-D1 == doctest::Approx(p0).epsilon(1e-12));
+    CHECK(D2 == doctest::Approx(p1).epsilon(1e-12));
+  }
+}
+
+TEST_CASE("shooting D1 and D2 are the derivatives of L_d") {
+  SeparablePendulum pendulum;
+  EulerMaclaurin2 rule;
+  auto method = rk4();
+  FlatSpace space(1);
+  for (ShootingForm form : {ShootingForm::lagrangian, ShootingForm::type_2}) {
+    ShootingDiscreteLagrangian shooting(space, pendulum, rule, method, form, {});
+    const double q0 = 0.3, q1 = 0.45, h = 0.2, e = 1e-5;
+    double Ld, D1, D2, plus, minus;
+    shooting.evaluate(&q0, &q1, h, &Ld, &D1, &D2);
+    // Test-only central differences of L_d in q0 and q1.
+    double a = q0 + e, b = q0 - e;
+    shooting.evaluate(&a, &q1, h, &plus, nullptr, nullptr);
+    shooting.evaluate(&b, &q1, h, &minus, nullptr, nullptr);
+    CHECK(D1 == doctest::Approx((plus - minus) / (2 * e)).epsilon(1e-8));
+    a = q1 + e;
+    b = q1 - e;
+    shooting.evaluate(&q0, &a, h, &plus, nullptr, nullptr);
+    shooting.evaluate(&q0, &b, h, &minus, nullptr, nullptr);
+    CHECK(D2 == doctest::Approx((plus - minus) / (2 * e)).epsilon(1e-8));
+  }
+}
+
+TEST_CASE("SVIMID's discrete Lagrangian is self-adjoint: L_d(q0, q1; h) = -L_d(q1, q0; -h)") {
+  SeparablePendulum pendulum;
+  auto rule = trapezoid();
+  auto method = implicit_midpoint();
+  FlatSpace space(1);
+  ShootingDiscreteLagrangian shooting(space, pendulum, rule, method, ShootingForm::lagrangian, {});
+  const double q0 = 0.3, q1 = 0.5, h = 0.25;
+  double forward, backward;
+  shooting.evaluate(&q0, &q1, h, &forward, nullptr, nullptr);
+  shooting.evaluate(&q1, &q0, -h, &backward, nullptr, nullptr);
+  CHECK(forward == doctest::Approx(-backward).epsilon(1e-13));
+}
+
+TEST_CASE("shooting with an affine-equivariant method conserves the angular momentum of a central force") {
+  PlanarKepler kepler;
+  auto rule = simpson();
+  auto method = rk4();
+  FlatSpace space(2);
+  ShootingDiscreteLagrangian shooting(space, kepler, rule, method, ShootingForm::lagrangian, {});
+  Eigen::Vector2d q(1.0, 0.0), p(0.1, 1.2), q1, p1;
+  const double J0 = q.x() * p.y() - q.y() * p.x();
+  double drift = 0.0;
+  for (int k = 0; k < 100; ++k) {
+    shooting.step(q.data(), p.data(), 0.1, q1.data(), p1.data());
+    q = q1;
+    p = p1;
+    drift = std::max(drift, std::abs(q.x() * p.y() - q.y() * p.x() - J0));
+  }
+  CAPTURE(drift);
+  CHECK(drift < 1e-12);
+}
+
+TEST_CASE("the shooting Newton iteration converges quadratically from the inverse Legendre guess") {
+  SeparablePendulum pendulum;
+  auto rule = simpson();
+  auto method = rk4();
+  FlatSpace space(1);
+  ShootingDiscreteLagrangian shooting(space, pendulum, rule, method, ShootingForm::lagrangian, {});
+  double q0 = 2.0, p0 = 0.5, q1, p1;
+  shooting.step(&q0, &p0, 1.0, &q1, &p1);  // a long step: the guess is off by ~1e-3
+  const auto& r = shooting.last_residuals();
+  REQUIRE(r.size() >= 3);
+  // Each residual well above round-off is at most C times the square of the one before.
+  for (std::size_t k = 1; k < r.size(); ++k) {
+    CAPTURE(k);
+    CAPTURE(r[k - 1]);
+    CAPTURE(r[k]);
+    if (r[k] > 1e-12) CHECK(r[k] <= 10.0 * r[k - 1] * r[k - 1]);
+  }
+  // At the paper's h = 0.2: at most 4 iterations per step, 3 on average or fewer.
+  for (int k = 0; k < 100; ++k) {
+    shooting.step(&q0, &p0, 0.2, &q1, &p1);
+    q0 = q1;
+    p0 = p1;
+  }
+  const auto& statistics = shooting.solver_statistics();
+  CAPTURE(statistics.mean());
+  CHECK(statistics.max_iterations <= 4);
+  CHECK(statistics.mean() <= 3.0);
+}
+
+TEST_CASE("implicit stage solves converge quadratically and are counted") {
+  SeparablePendulum pendulum;
+  auto rule = trapezoid();
+  auto method = implicit_midpoint();
+  FlatSpace space(1);
+  ShootingDiscreteLagrangian shooting(space, pendulum, rule, method, ShootingForm::lagrangian, {});
+  double q0 = 1.0, p0 = 0.5, q1, p1;
+  shooting.step(&q0, &p0, 0.2, &q1, &p1);
+  const auto& stages = shooting.stage_statistics();
+  CAPTURE(stages.mean());
+  CHECK(stages.solves > 0);
+  CHECK(stages.max_iterations <= 5);
+}
+
+TEST_CASE("a shooting solve that does not converge raises a numerical failure") {
+  SeparablePendulum pendulum;
+  auto rule = simpson();
+  FlatSpace space(1);
+  double q0 = 2.0, p0 = 0.5, q1, p1;
+  SUBCASE("too few iterations") {
+    auto method = rk4();
+    SolverOptions options;
+    options.max_iterations = 1;
+    ShootingDiscreteLagrangian shooting(space, pendulum, rule, method, ShootingForm::lagrangian,
+                                        options);
+    CHECK_THROWS_AS(shooting.step(&q0, &p0, 0.5, &q1, &p1), NumericalFailure);
+  }
+  SUBCASE("a non-finite Lagrangian inside the propagation (a collision of the central force)") {
+    PlanarKepler kepler;
+    auto method = rk4();
+    FlatSpace plane(2);
+    ShootingDiscreteLagrangian shooting(plane, kepler, rule, method, ShootingForm::lagrangian, {});
+    const double q[2] = {0.0, 0.0}, p[2] = {1.0, 0.0};
+    double qq[2], pp[2];
+    CHECK_THROWS_AS(shooting.step(q, p, 0.1, qq, pp), NumericalFailure);
+  }
+  SUBCASE("implicit stages that do not converge") {
+    auto method = implicit_midpoint();
+    SolverOptions options;
+    options.max_iterations = 2;
+    ShootingDiscreteLagrangian shooting(space, pendulum, rule, method, ShootingForm::lagrangian,
+                                        options);
+    CHECK_THROWS_AS(shooting.step(&q0, &p0, 3.0, &q1, &p1), NumericalFailure);
+  }
+}
+
+TEST_CASE("the shooting construction refuses a Lagrangian without a constant mass matrix") {
+  Pendulum pendulum;  // declares no mass matrix
+  auto rule = simpson();
+  auto method = rk4();
+  FlatSpace space(1);
+  CHECK_THROWS_AS(ShootingDiscreteLagrangian(space, pendulum, rule, method,
+                                             ShootingForm::lagrangian, {}),
+                  std::invalid_argument);
+  CHECK_THROWS_AS(shooting_form("type-3"), std::invalid_argument);
+}
+
+TEST_CASE("the one-step construction: MID is order 2, SRK4 (2-stage Gauss) order 4") {
+  SeparablePendulum pendulum;
+  const Eigen::Vector2d reference = pendulum_reference();
+  auto mid = implicit_midpoint();
+  auto srk4 = gauss2();
+  for (auto [method, expected] : {std::pair<OneStepMethod*, double>{&mid, 2.0}, {&srk4, 4.0}}) {
+    const auto e = errors(
+        [&](double h, int n) {
+          FlatSpace space(1);
+          OneStepHamiltonianMap map(space, pendulum, *method, {});
+          return run(map, Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Constant(1, 0.5), h, n);
+        },
+        reference);
+    const double order = order_of(e);
+    CAPTURE(order);
+    CHECK(order == doctest::Approx(expected).epsilon(0.05));
+  }
+}
+
+TEST_SUITE("long") {
+  // The paper's "Energy error, step size h = 0.2" panels: bounded, no drift over 10^4 steps.
+  TEST_CASE("SVIRK4 and SVIMID energy errors stay bounded without drift over 10^4 steps at h = 0.2") {
+    SeparablePendulum pendulum;
+    auto simp = simpson();
+    auto trap = trapezoid();
+    auto rk = rk4();
+    auto mid = implicit_midpoint();
+    for (auto [method, rule] : {std::pair<OneStepMethod*, Quadrature*>{&rk, &simp}, {&mid, &trap}}) {
+      FlatSpace space(1);
+      ShootingDiscreteLagrangian shooting(space, pendulum, *rule, *method,
+                                          ShootingForm::lagrangian, {});
+      double q = 1.0, p = 0.5, q1, p1;
+      const double E0 = 0.5 * p * p - std::cos(q);
+      double first = 0.0, last = 0.0;  // the largest error in the first and the last 1000 steps
+      for (int k = 0; k < 10000; ++k) {
+        shooting.step(&q, &p, 0.2, &q1, &p1);
+        q = q1;
+        p = p1;
+        const double error = std::abs(0.5 * p * p - std::cos(q) - E0);
+        if (k < 1000) first = std::max(first, error);
+        if (k >= 9000) last = std::max(last, error);
+      }
+      CAPTURE(first);
+      CAPTURE(last);
+      CHECK(last <= 1.5 * first);
+      CHECK(last < 1e-2);
+    }
+  }
+}

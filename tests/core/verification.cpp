@@ -1,0 +1,119 @@
+#include "varia/core/verification.hpp"
+
+#include <doctest/doctest.h>
+
+#include <cmath>
+
+#include "core/fixtures.hpp"
+#include "varia/core/galerkin.hpp"
+
+using namespace varia;
+using namespace varia::testing;
+
+namespace {
+
+// Symplectic Euler's non-symplectic cousin, explicit Euler on the unit pendulum: a map that the
+// property checks must reject.
+struct ExplicitEuler : DiscreteHamiltonianMap {
+  int point_size() const override { return 1; }
+  int dim() const override { return 1; }
+  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override {
+    const double q = q0[0], p = p0[0];
+    q1[0] = q + h * p;
+    p1[0] = p - h * std::sin(q);
+  }
+  const SolverStatistics& solver_statistics() const override { return statistics; }
+  const EvaluationCounters& evaluations() const override { return counters; }
+  SolverStatistics statistics;
+  EvaluationCounters counters;
+};
+
+std::vector<double> pendulum_energy_errors(DiscreteHamiltonianMap& map, long steps) {
+  std::vector<double> errors;
+  const double E0 = -std::cos(1.3);
+  run(map, {1.3}, {0.0}, 0.1, steps, [&](long, const double* q, const double* p) {
+    errors.push_back(0.5 * p[0] * p[0] - std::cos(q[0]) - E0);
+  });
+  return errors;
+}
+
+}  // namespace
+
+TEST_CASE("order fit drops round-off and pre-asymptotic points and finds the slope") {
+  std::vector<double> h, e;
+  for (int k = 0; k < 8; ++k) {
+    h.push_back(0.4 / (1 << k));
+    e.push_back(k == 0 ? 0.5 : std::max(3.0 * std::pow(h.back(), 4), 1e-15));
+  }
+  const OrderFit fit = fit_order(h, e, 1e-13);
+  CAPTURE(fit.slope);
+  CHECK(fit.slope == doctest::Approx(4.0).epsilon(0.01));
+  CHECK(fit.dropped.size() >= 1);
+}
+
+TEST_CASE("galerkin with the trapezoid rule is self-adjoint; with a one-sided rule it is not") {
+  FlatSpace space(1);
+  Pendulum pendulum;
+  const double q = 0.4, v = 0.3, h = 0.1;
+  auto pairs = sample_pairs(space, &q, &v, h, 5);
+  auto symmetric = trapezoid();
+  FixedRule left({0.0}, {1.0}, 0);
+  GalerkinDiscreteLagrangian a(space, pendulum, symmetric, equispaced_control_times(1), {});
+  GalerkinDiscreteLagrangian b(space, pendulum, left, equispaced_control_times(1), {});
+  const double residual_symmetric = self_adjointness_residual(a, pairs, h);
+  const double residual_left = self_adjointness_residual(b, pairs, h);
+  CAPTURE(residual_symmetric);
+  CAPTURE(residual_left);
+  CHECK(residual_symmetric < 1e-13);
+  CHECK(residual_left > 1e-4);
+}
+
+TEST_CASE("the symplecticity defect is at round-off for galerkin and large for explicit Euler") {
+  FlatSpace space(1);
+  Pendulum pendulum;
+  auto rule = lobatto3();
+  GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(2), {});
+  ExplicitEuler euler;
+  const double q = 1.0, p = 0.2;
+  const auto variational = symplecticity_defect(galerkin, &q, &p, 0.1);
+  const auto naive = symplecticity_defect(euler, &q, &p, 0.1);
+  CAPTURE(variational.defect);
+  CAPTURE(variational.noise);
+  CAPTURE(naive.defect);
+  CHECK(variational.defect < 1e-9);
+  CHECK(naive.defect > 1e-3);
+}
+
+TEST_CASE("the energy error of galerkin does not drift; that of explicit Euler does") {
+  FlatSpace space(1);
+  Pendulum pendulum;
+  auto rule = trapezoid();
+  GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(1), {});
+  ExplicitEuler euler;
+  const double bounded = drift_ratio(pendulum_energy_errors(galerkin, 4000));
+  const double drifting = drift_ratio(pendulum_energy_errors(euler, 4000));
+  CAPTURE(bounded);
+  CAPTURE(drifting);
+  CHECK(bounded < 1.5);
+  CHECK(drifting > 2.0);
+}
+
+TEST_CASE("predictions follow the paper's theorems") {
+  Composition galerkin{Composition::Construction::galerkin};
+  galerkin.quadrature_order = 4;
+  galerkin.quadrature_symmetric = galerkin.control_times_symmetric = true;
+  galerkin.degree = 3;
+  CHECK(*predict(galerkin).ld_order == 4);  // min(2s = 6, q = 4)
+  CHECK(*predict(galerkin).self_adjoint);
+  Composition shooting{Composition::Construction::shooting};
+  shooting.quadrature_order = 4;
+  shooting.quadrature_symmetric = true;
+  shooting.method_order = 4;
+  shooting.method_self_adjoint = false;  // rk4
+  CHECK(*predict(shooting).global_order == 4);
+  CHECK_FALSE(*predict(shooting).self_adjoint);
+  shooting.lagrangian_invariant = true;
+  CHECK_FALSE(*predict(shooting).g_invariant);
+  shooting.method_equivariant = true;
+  CHECK(*predict(shooting).momentum_conserved);
+}

@@ -1,0 +1,234 @@
+// End-to-end tests of the varia program (spec: "Commands", "Exit codes", "Outputs"): every
+// example scene runs and writes the spec's CSV header and run record; every bad scene exits 2
+// naming the JSON pointer of the bad field.
+#include <doctest/doctest.h>
+
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "host/support.hpp"
+
+namespace varia::test {
+namespace {
+
+using nlohmann::json;
+
+// Spec "Outputs": t, q0.., p0.., then energy; momentum0..; orthogonality as asked.
+std::vector<std::string> expected_header(const json& scene, int momentum_columns) {
+  std::vector<std::string> columns{"t"};
+  const auto& initial = scene["initial"];
+  for (std::size_t i = 0; i < initial["q"].size(); ++i) columns.push_back("q" + std::to_string(i));
+  const auto& p = initial.contains("p") ? initial["p"] : initial["v"];
+  for (std::size_t i = 0; i < p.size(); ++i) columns.push_back("p" + std::to_string(i));
+  const auto observe = scene.value("observe", json::array());
+  const auto asked = [&](const char* name) { return std::find(observe.begin(), observe.end(), name) != observe.end(); };
+  if (asked("energy")) columns.emplace_back("energy");
+  for (int i = 0; i < momentum_columns; ++i) columns.push_back("momentum" + std::to_string(i));
+  if (asked("orthogonality")) columns.emplace_back("orthogonality");
+  return columns;
+}
+
+std::vector<std::string> split(const std::string& line) {
+  std::vector<std::string> cells;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, ',')) cells.push_back(cell);
+  return cells;
+}
+
+int count_momentum_columns(const std::vector<std::string>& header) {
+  return static_cast<int>(std::count_if(header.begin(), header.end(),
+                                        [](const std::string& c) { return c.rfind("momentum", 0) == 0; }));
+}
+
+long rows_expected(long steps, long every) { return steps / every + 1 + (steps % every != 0 ? 1 : 0); }
+
+void check_run_record(const json& scene, const json& record, long rows) {
+  const double step = scene["step"];
+  const long steps = scene.contains("steps") ? scene["steps"].get<long>()
+                                             : std::lround(scene["t_end"].get<double>() / step);
+  CHECK(record["steps"] == steps);
+  CHECK(record["final"]["t"].get<double>() == doctest::Approx(steps * step));
+  for (const char* key : {"wall_seconds", "newton_iterations", "evaluations", "final", "plugins_loaded"})
+    CHECK_MESSAGE(record.contains(key), key);
+  const auto observe = scene.value("observe", json::array());
+  const bool energy = std::find(observe.begin(), observe.end(), "energy") != observe.end();
+  CHECK(record.contains("energy_error_max") == energy);
+  CHECK_FALSE(record.contains("failure"));
+  const auto& loaded = record["plugins_loaded"];
+  CHECK(std::find(loaded.begin(), loaded.end(), scene["system"]["lagrangian"]["type"]) != loaded.end());
+  const long every = scene.contains("output") ? scene["output"].value("every", 1L) : 1L;
+  CHECK(rows == rows_expected(steps, every));
+}
+
+TEST_CASE("every example scene runs, writing the spec's CSV header and run record") {
+  for (const auto& file : files_in(kSourceDir / "scenes", ".json")) {
+    CAPTURE(file);
+    TempDir dir;
+    const auto outcome = run_varia("run '" + file.string() + "' --quiet --out '" + (dir / "t.csv").string() +
+                                   "' --summary '" + (dir / "r.json").string() + "'");
+    CAPTURE(outcome.err);
+    REQUIRE(outcome.code == 0);
+    CHECK(outcome.err.empty());
+    const json scene = json::parse(read_file(file));
+    const auto lines = lines_of(read_file(dir / "t.csv"));
+    REQUIRE(lines.size() >= 2);
+    const auto header = split(lines[0]);
+    CHECK(header == expected_header(scene, count_momentum_columns(header)));
+    CHECK(split(lines.back()).size() == header.size());
+    check_run_record(scene, json::parse(read_file(dir / "r.json")), static_cast<long>(lines.size()) - 1);
+  }
+}
+
+TEST_CASE("every example scene validates") {
+  for (const auto& file : files_in(kSourceDir / "scenes", ".json")) {
+    CAPTURE(file);
+    const auto outcome = run_varia("validate '" + file.string() + "'");
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == 0);
+  }
+}
+
+// Each bad scene and what its one error line must name (the JSON pointer, or line and column).
+const std::map<std::string, std::string> kBadScenes{
+    {"bad-parameter-type.json", "/system/lagrangian/mass: expected a number"},
+    {"bad-quadrature-parameter.json", "/method/quadrature/points: expected an integer >= 2"},
+    {"degree-zero.json", "/method/degree: expected an integer >= 1"},
+    {"galerkin-without-quadrature.json", "/method/quadrature: missing"},
+    {"missing-step.json", "/step: missing"},
+    {"momentum-without-symmetry.json", "/observe: "},
+    {"negative-step.json", "/step: expected a number > 0"},
+    {"p-and-v.json", "/initial/p: not allowed here"},
+    {"steps-and-t_end.json", "/t_end: not allowed here"},
+    {"syntax-error.json", "invalid JSON at line 7, column"},
+    {"t_end-not-whole-steps.json", "/t_end: expected a whole number of steps"},
+    {"unknown-key.json", "/method/degre: unknown key 'degre'"},
+    {"unknown-lagrangian.json", "/system/lagrangian/type: unknown lagrangian type 'pendulm'; valid lagrangian types are: "},
+    {"unknown-observable.json", "/observe/0: expected one of \"energy\""},
+    {"wrong-q-size.json", "/initial/q: expected 1 number"},
+};
+
+void check_one_error_line(const Outcome& outcome, const std::string& expected) {
+  const auto lines = lines_of(outcome.err);
+  REQUIRE(lines.size() == 1);
+  CHECK(lines[0].rfind("varia: error: ", 0) == 0);
+  CHECK(contains(lines[0], expected));
+}
+
+TEST_CASE("every bad scene exits 2 with one line naming the bad field") {
+  const auto files = files_in(kSourceDir / "scenes" / "bad", ".json");
+  CHECK(files.size() == kBadScenes.size());  // a new bad scene needs its row in the table
+  for (const auto& file : files) {
+    CAPTURE(file);
+    const auto it = kBadScenes.find(file.filename().string());
+    REQUIRE(it != kBadScenes.end());
+    for (const char* command : {"validate", "run"}) {
+      CAPTURE(command);
+      const auto outcome = run_varia(std::string(command) + " '" + file.string() + "'");
+      CAPTURE(outcome.err);
+      CHECK(outcome.code == 2);
+      check_one_error_line(outcome, it->second);
+    }
+  }
+}
+
+struct CommandCase {
+  const char* arguments;
+  int code;
+  const char* output;  // expected in stdout (code 0) or in the one stderr line
+};
+
+TEST_CASE("command line: help and version exit 0, bad flags and unfinished commands exit 2") {
+  const CommandCase cases[] = {
+      {"--help", 0, "Subcommands:"},
+      {"run --help", 0, "--summary"},
+      {"ld --help", 0, "--q0"},
+      {"--version", 0, "0."},
+      {"", 2, "A subcommand is required"},
+      {"run", 2, "SCENE is required"},
+      {"run scenes/default.json --bogus", 2, "--bogus"},
+      {"frobnicate", 2, "unknown command 'frobnicate'; the commands are: plugins, run"},
+      {"run no/such/scene.json", 2, "no/such/scene.json: cannot be read"},
+      {"verify scenes/default.json", 2, "not available yet"},
+      {"cost scenes/default.json", 2, "not available yet"},
+      {"ld scenes/default.json --q0 1.3,2 --q1 1.2 --h 0.1", 2, "--q0: expected 1 comma-separated"},
+      {"ld scenes/default.json --q0 1.3 --q1 abc --h 0.1", 2, "--q1: expected 1"},
+      {"ld scenes/default.json --q0 1.3 --q1 1.2 --h -1", 2, "--h: expected a number > 0"},
+  };
+  for (const auto& c : cases) {
+    const std::string arguments = c.arguments;
+    CAPTURE(arguments);
+    const auto outcome = run_varia(c.arguments);
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == c.code);
+    if (c.code == 0)
+      CHECK(contains(outcome.out, c.output));
+    else
+      check_one_error_line(outcome, c.output);
+  }
+}
+
+TEST_CASE("ld --json prints exactly Ld, D1 and D2") {
+  const auto outcome = run_varia("ld scenes/kepler-galerkin.json --q0 0.5,0 --q1 0.5,0.017 --h 0.01 --json");
+  CAPTURE(outcome.err);
+  REQUIRE(outcome.code == 0);
+  const json result = json::parse(outcome.out);
+  CHECK(result.size() == 3);
+  CHECK(result["Ld"].is_number());
+  CHECK(result["D1"].size() == 2);
+  CHECK(result["D2"].size() == 2);
+}
+
+TEST_CASE("plugins --json lists the bundled plugins; a junk file in --plugin-path is refused, the rest works") {
+  TempDir dir;
+  write_file(dir / "junk.so", "not a library\n");
+  const auto listing = run_varia("plugins --json --plugin-path '" + dir.path().string() + "'");
+  REQUIRE(listing.code == 0);
+  const json plugins = json::parse(listing.out);
+  const bool has_pendulum = std::any_of(plugins.begin(), plugins.end(), [](const json& p) {
+    return p["kind"] == "lagrangian" && p["type"] == "pendulum";
+  });
+  CHECK(has_pendulum);
+  CHECK(contains(listing.err, "junk.so"));
+  const auto table = run_varia("plugins --plugin-path '" + dir.path().string() + "'");
+  CHECK(table.code == 0);
+  CHECK(contains(table.out, "refused:"));
+  CHECK(run_varia("run scenes/default.json --quiet --plugin-path '" + dir.path().string() + "'").code == 0);
+}
+
+TEST_CASE("a solve that does not converge exits 4; the rows written stay whole; the record names the failure") {
+  TempDir dir;
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
+  scene["method"]["solver"] = {{"tolerance", 1e-300}, {"max_iterations", 1}};
+  write_file(dir / "scene.json", scene.dump());
+  const auto outcome = run_varia("run '" + (dir / "scene.json").string() + "' --out '" + (dir / "t.csv").string() +
+                                 "' --summary '" + (dir / "r.json").string() + "'");
+  CHECK(outcome.code == 4);
+  check_one_error_line(outcome, "step 1 (from t = 0) failed");
+  CHECK(contains(outcome.err, "residual"));
+  const auto lines = lines_of(read_file(dir / "t.csv"));
+  REQUIRE(lines.size() >= 2);
+  for (const auto& line : lines) CHECK(split(line).size() == 4);
+  const json record = json::parse(read_file(dir / "r.json"));
+  CHECK(record["failure"]["step"] == 1);
+  CHECK(record["failure"].contains("residual"));
+}
+
+TEST_CASE("output.every writes every k-th step, step 0 and the last step") {
+  TempDir dir;
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
+  scene.erase("t_end");
+  scene["steps"] = 10;
+  scene["output"] = {{"every", 4}};
+  write_file(dir / "scene.json", scene.dump());
+  const auto outcome = run_varia("run '" + (dir / "scene.json").string() + "' --quiet --out '" +
+                                 (dir / "t.csv").string() + "'");
+  REQUIRE(outcome.code == 0);
+  const auto lines = lines_of(read_file(dir / "t.csv"));
+  std::vector<std::string> times;
+  for (std::size_t i = 1; i < lines.size(); ++i) times.push_back(split(lines[i])[0]);
+  CHECK(times == std::vector<std::string>{"0", "0.4", "0.8", "1"});
+}
+
+}  // namespace
+}  // namespace varia::test

@@ -1,0 +1,75 @@
+// Scene parsing without plugins (spec: "Scene files (JSON)"): what the Scene holds, and the one
+// line each schema violation becomes.
+#include "scene.hpp"
+
+#include <doctest/doctest.h>
+
+#include "host/support.hpp"
+#include "registry.hpp"
+
+namespace varia::host {
+namespace {
+
+using nlohmann::json;
+
+json default_scene() { return json::parse(test::read_file(test::kSourceDir / "scenes" / "default.json")); }
+
+TEST_CASE("a scene holds its construction, steps from t_end, observables and plugin objects") {
+  json document = default_scene();
+  document["t_end"] = 0.30000000000000004;  // 3 steps of 0.1 up to rounding
+  document["step"] = 0.1;
+  const Scene scene = parse_scene(document);
+  CHECK(scene.construction == "galerkin");
+  CHECK(scene.steps == 3);
+  CHECK(scene.degree == 2);
+  CHECK(scene.observe.energy);
+  CHECK_FALSE(scene.observe.momentum);
+  CHECK(scene.output_every == 1);
+  CHECK(scene.lagrangian.pointer == "/system/lagrangian");
+  CHECK(scene.lagrangian.type == "pendulum");
+  CHECK_FALSE(scene.lagrangian.parameters.contains("type"));
+  CHECK(scene.quadrature->parameters == json{{"points", 3}});
+  CHECK(scene.plugins().size() == 3);
+}
+
+struct Bad {
+  const char* pointer;  // where to put the value
+  json value;
+  const char* message;  // the start of the one-line error
+};
+
+TEST_CASE("each schema violation is one line naming its JSON pointer and what was expected") {
+  const Bad cases[] = {
+      {"/method/control_times", json{0.0, 1.0}, "/method/control_times: expected degree + 1 = 3 increasing"},
+      {"/method/solver", json{{"tolerance", 0}}, "/method/solver/tolerance: expected a number > 0"},
+      {"/method/solver", json{{"max_iterations", 0}}, "/method/solver/max_iterations: expected an integer >= 1"},
+      {"/method/solver", "cayley", "/method/solver: expected {\"tolerance\""},
+      {"/method/construction", "galerkn", "/method/construction: expected one of \"galerkin\""},
+      {"/method/form", "hamiltonian", "/method/form: not allowed here"},
+      {"/output", json{{"every", 0}}, "/output/every: expected an integer >= 1"},
+      {"/observe", json{"energy", "energy"}, "/observe: expected an array"},
+      {"/initial/q", json{"a"}, "/initial/q/0: expected a number"},
+      {"/system/manifold", json{{"dim", 1}}, "/system/manifold/type: missing"},
+      {"/system/manifold/type", 3, "/system/manifold/type: expected a string"},
+      {"/steps", 0, "/steps: expected an integer >= 1"},
+  };
+  for (const auto& c : cases) {
+    const std::string pointer = c.pointer;
+    CAPTURE(pointer);
+    json document = default_scene();
+    document[json::json_pointer(c.pointer)] = c.value;
+    if (pointer == "/steps") document.erase("t_end");
+    std::string message = "(nothing thrown)";
+    try {
+      parse_scene(document);
+    } catch (const InputError& e) {
+      message = e.what();
+    }
+    CAPTURE(message);
+    CHECK(message.rfind(c.message, 0) == 0);
+    CHECK(message.find('\n') == std::string::npos);
+  }
+}
+
+}  // namespace
+}  // namespace varia::host
