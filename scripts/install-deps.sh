@@ -6,6 +6,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libboost-dev nlohmann-json3-dev libfmt-dev doctest-dev libcli11-dev
   libvalijson-dev gnuplot-nox
+  clang libclang-rt-14-dev  # the scene fuzzer (ctest -L fuzz): libFuzzer
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -1,5 +1,6 @@
 #include "varia/core/galerkin.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -66,10 +67,13 @@ Eigen::VectorXd LagrangeBasis::at(double tau) const {
 GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian,
                                                        Quadrature& quadrature,
                                                        std::vector<double> control_times,
-                                                       SolverOptions options)
+                                                       SolverOptions options,
+                                                       std::vector<Force*> forces)
     : lagrangian_(lagrangian),
+      forces_(std::move(forces), manifold.dim(), manifold.dim()),
       basis_(control_times, quadrature),
       weights_(Eigen::Map<const Eigen::VectorXd>(quadrature.weights(), quadrature.size())),
+      nodes_(Eigen::Map<const Eigen::VectorXd>(quadrature.nodes(), quadrature.size())),
       options_(options),
       n_(manifold.dim()),
       s_(static_cast<int>(control_times.size()) - 1) {
@@ -88,18 +92,40 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   v_.resize(n_);
   velocity_ = Eigen::VectorXd::Zero(n_);
   grad_.resize(2 * n_);
-  hess_.resize(2 * n_, 2 * n_);
   gradient_.resize((s_ + 1) * n_);
-  hessian_.resize((s_ + 1) * n_, (s_ + 1) * n_);
   residual_.resize(s_ * n_);
   update_.resize(s_ * n_);
-  jacobian_.resize(s_ * n_, s_ * n_);
-  lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(s_ * n_);
+  f_.resize(n_);
+  force_values_.resize(static_cast<Eigen::Index>(forces_.rows().size()));
   residuals_.reserve(options_.max_iterations + 1);
+  if (lagrangian_.sparse()) {
+    sparse_values_.resize(lagrangian_.pattern_size());
+    for (int e = 0; e < lagrangian_.pattern_size(); ++e) {
+      const int r = lagrangian_.pattern_rows()[e], c = lagrangian_.pattern_cols()[e];
+      entries_.push_back(Entry{r % n_, c % n_, r >= n_, c >= n_});
+    }
+  } else {
+    hess_.resize(2 * n_, 2 * n_);
+    hessian_.resize((s_ + 1) * n_, (s_ + 1) * n_);
+    jacobian_.resize(s_ * n_, s_ * n_);
+    lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(s_ * n_);
+  }
+  // The forces' Jacobian [df/dq, df/dv]: rows are equations (weighted by l_nu, never by v).
+  for (std::size_t e = 0; e < forces_.rows().size(); ++e)
+    entries_.push_back(Entry{forces_.rows()[e], forces_.cols()[e] % n_, false, forces_.cols()[e] >= n_});
   explicit_ = explicit_form_applies(quadrature);
 }
 
+const EvaluationCounters& GalerkinDiscreteLagrangian::evaluations() const {
+  counters_ = lagrangian_.counters();
+  counters_.force = forces_.evaluations();
+  return counters_;
+}
+
+// Not with forces (f(v) makes the equations implicit) nor for a sparse Lagrangian (the explicit
+// form factorizes a dense mass matrix).
 bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
+  if (!forces_.empty() || lagrangian_.sparse()) return false;
   mass_matrix_.resize(n_, n_);
   if (s_ != 1 || !lagrangian_.plugin().constant_mass_matrix(mass_matrix_.data())) return false;
   for (int i = 0; i < quadrature.size(); ++i) {
@@ -142,23 +168,35 @@ void GalerkinDiscreteLagrangian::explicit_step(const double* q0, const double* p
   statistics_.record(0);
 }
 
+void GalerkinDiscreteLagrangian::interpolate(int i, double h) {
+  q_.noalias() = points_ * basis_.phi.row(i).transpose();
+  v_.noalias() = points_ * basis_.dphi.row(i).transpose();
+  v_ /= h;
+}
+
+double GalerkinDiscreteLagrangian::weight(int i, int nu, bool by_v, double h) const {
+  return by_v ? basis_.dphi(i, nu) / h : basis_.phi(i, nu);
+}
+
 // S = h sum_i b_i L(q_i, v_i), q_i = sum_nu l_nu(c_i) q^nu, v_i = (1/h) sum_nu l'_nu(c_i) q^nu
 // (paper, sec. 2), and by the chain rule
 //   dS/dq^nu = sum_i b_i (h l_nu L_q + l'_nu L_v),
 //   d2S/dq^nu dq^mu = sum_i b_i (h l_nu l_mu L_qq + l_nu l'_mu L_qv + l'_nu l_mu L_vq
 //                                + l'_nu l'_mu L_vv / h).
-double GalerkinDiscreteLagrangian::action(double h, Order order) {
+double GalerkinDiscreteLagrangian::action(double h, Order order, bool forced) {
   const int n = n_;
+  const bool sparse = lagrangian_.sparse();
   double S = 0.0;
   if (order != Order::value) gradient_.setZero();
-  if (order == Order::hessian) hessian_.setZero();
+  if (order == Order::hessian && sparse) sparse_.matrix.coeffs().setZero();
+  if (order == Order::hessian && !sparse) hessian_.setZero();
   for (int i = 0; i < basis_.phi.rows(); ++i) {
     if (weights_[i] == 0.0) continue;
-    q_.noalias() = points_ * basis_.phi.row(i).transpose();
-    v_.noalias() = points_ * basis_.dphi.row(i).transpose();
-    v_ /= h;
+    interpolate(i, h);
     double L = 0.0;
-    if (order == Order::hessian)
+    if (order == Order::hessian && sparse)
+      L = lagrangian_.sparse_hessian(q_.data(), v_.data(), grad_.data(), sparse_values_.data());
+    else if (order == Order::hessian)
       L = lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data());
     else if (order == Order::gradient)
       L = lagrangian_.gradient(q_.data(), v_.data(), grad_.data());
@@ -167,10 +205,13 @@ double GalerkinDiscreteLagrangian::action(double h, Order order) {
     const double b = weights_[i];
     S += h * b * L;
     if (order == Order::value) continue;
+    if (forced) add_forces(i, h, order);
+    if (order == Order::hessian && sparse)
+      add_sparse_entries(i, h, 0, sparse_values_.data(), static_cast<int>(sparse_values_.size()), h * b);
     for (int nu = 0; nu <= s_; ++nu) {
       const double a = basis_.phi(i, nu), da = basis_.dphi(i, nu);
       gradient_.segment(nu * n, n) += b * (h * a * grad_.head(n) + da * grad_.tail(n));
-      if (order != Order::hessian) continue;
+      if (order != Order::hessian || sparse) continue;
       for (int mu = 0; mu <= s_; ++mu) {
         const double c = basis_.phi(i, mu), dc = basis_.dphi(i, mu);
         hessian_.block(nu * n, mu * n, n, n) +=
@@ -182,14 +223,107 @@ double GalerkinDiscreteLagrangian::action(double h, Order order) {
   return S;
 }
 
-void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
-                                        int blocks, const double* p0) {
+// f_d^nu += h b_i l_nu(c_i) f(t + c_i h, q_i, v_i) (Marsden & West 2001, sec. 3.2, through the
+// quadrature), and d f_d^nu / dq^mu += h b_i l_nu (l_mu df/dq + l'_mu/h df/dv).
+void GalerkinDiscreteLagrangian::add_forces(int i, double h, Order order) {
+  const bool jacobian = order == Order::hessian;
+  forces_.evaluate(t_ + nodes_[i] * h, q_.data(), v_.data(), f_.data(),
+                   jacobian ? force_values_.data() : nullptr);
+  const double w = h * weights_[i];
+  for (int nu = 0; nu <= s_; ++nu) gradient_.segment(nu * n_, n_) += w * basis_.phi(i, nu) * f_;
+  if (!jacobian) return;
+  const int first = static_cast<int>(entries_.size() - force_values_.size());
+  if (lagrangian_.sparse())
+    return add_sparse_entries(i, h, first, force_values_.data(), static_cast<int>(force_values_.size()), w);
+  for (Eigen::Index k = 0; k < force_values_.size(); ++k) {
+    const Entry& e = entries_[first + k];
+    for (int nu = 0; nu <= s_; ++nu)
+      for (int mu = 0; mu <= s_; ++mu)
+        hessian_(nu * n_ + e.row, mu * n_ + e.col) +=
+            w * force_values_[k] * weight(i, nu, e.row_v, h) * weight(i, mu, e.col_v, h);
+  }
+}
+
+void GalerkinDiscreteLagrangian::add_sparse_entries(int i, double h, int first_entry,
+                                                    const double* values, int count, double w) {
+  const int blocks = sparse_.blocks;
+  double* coefficients = sparse_.matrix.valuePtr();
+  for (int k = 0; k < count; ++k) {
+    const Entry& e = entries_[first_entry + k];
+    const int* slot = &sparse_.slots[static_cast<std::size_t>(first_entry + k) * blocks * blocks];
+    for (int nu = 0; nu < blocks; ++nu) {
+      const double row = w * values[k] * weight(i, sparse_.first_equation + nu, e.row_v, h);
+      for (int mu = 0; mu < blocks; ++mu)
+        coefficients[slot[nu * blocks + mu]] += row * weight(i, sparse_.first_unknown + mu, e.col_v, h);
+    }
+  }
+}
+
+// The structure: every entry in every block (nu, mu) of the equations and unknowns, summed where
+// entries coincide; slots_ records where each (entry, nu, mu) landed in the compressed matrix.
+void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equation, int blocks) {
+  if (sparse_.first_unknown == first_unknown && sparse_.first_equation == first_equation &&
+      sparse_.blocks == blocks)
+    return;
+  sparse_.first_unknown = first_unknown;
+  sparse_.first_equation = first_equation;
+  sparse_.blocks = blocks;
+  std::vector<Eigen::Triplet<double>> triplets;
+  triplets.reserve(entries_.size() * blocks * blocks);
+  for (const Entry& e : entries_)
+    for (int nu = 0; nu < blocks; ++nu)
+      for (int mu = 0; mu < blocks; ++mu) triplets.emplace_back(nu * n_ + e.row, mu * n_ + e.col, 0.0);
+  sparse_.matrix.resize(blocks * n_, blocks * n_);
+  sparse_.matrix.setFromTriplets(triplets.begin(), triplets.end());
+  sparse_.matrix.makeCompressed();
+  sparse_.slots.resize(triplets.size());
+  const int* outer = sparse_.matrix.outerIndexPtr();
+  const int* inner = sparse_.matrix.innerIndexPtr();
+  for (std::size_t k = 0; k < triplets.size(); ++k) {
+    const int col = triplets[k].col(), row = triplets[k].row();
+    sparse_.slots[k] = static_cast<int>(std::lower_bound(inner + outer[col], inner + outer[col + 1], row) - inner);
+  }
+  sparse_.analyzed = false;
+}
+
+void GalerkinDiscreteLagrangian::solve_dense(int first_unknown, int first_equation, int blocks) {
   const int size = blocks * n_;
+  auto residual = residual_.head(size);
+  auto update = update_.head(size);
+  if (size == jacobian_.rows()) {
+    jacobian_ = hessian_.block(first_equation * n_, first_unknown * n_, size, size);
+    lu_.compute(jacobian_);
+    update.noalias() = lu_.solve(residual);
+  } else {
+    update = hessian_.block(first_equation * n_, first_unknown * n_, size, size).partialPivLu().solve(residual);
+  }
+}
+
+// Eigen's SparseLU: the symbolic analysis (COLAMD ordering) once per structure, the numerical
+// factorization per Newton iteration.
+void GalerkinDiscreteLagrangian::solve_sparse() {
+  if (!sparse_.analyzed) {
+    sparse_.lu.analyzePattern(sparse_.matrix);
+    sparse_.analyzed = true;
+  }
+  sparse_.lu.factorize(sparse_.matrix);
+  if (sparse_.lu.info() != Eigen::Success)
+    throw NumericalFailure("the Galerkin Newton Jacobian is singular: " + sparse_.lu.lastErrorMessage(),
+                           std::nan(""));
+  const Eigen::Index size = sparse_.matrix.rows();
+  update_.head(size) = sparse_.lu.solve(residual_.head(size));
+}
+
+void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
+                                        int blocks, const double* p0, bool forced) {
+  const int size = blocks * n_;
+  const bool sparse = lagrangian_.sparse();
+  if (sparse) prepare_sparse(first_unknown, first_equation, blocks);
   residuals_.clear();
   auto residual = residual_.head(size);
   auto update = update_.head(size);
   for (int iteration = 0;; ++iteration) {
-    action(h, Order::hessian);
+    action(h, Order::hessian, forced);
     residual = gradient_.segment(first_equation * n_, size);
     double scale = gradient_.lpNorm<Eigen::Infinity>();
     if (p0 != nullptr) {
@@ -206,19 +340,14 @@ void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_e
       throw NumericalFailure("Newton's method did not converge in " +
                                  std::to_string(options_.max_iterations) + " iterations",
                              norm);
-    if (size == jacobian_.rows()) {
-      jacobian_ = hessian_.block(first_equation * n_, first_unknown * n_, size, size);
-      lu_.compute(jacobian_);
-      update.noalias() = lu_.solve(residual);
-    } else {
-      update = hessian_.block(first_equation * n_, first_unknown * n_, size, size)
-                   .partialPivLu()
-                   .solve(residual);
-    }
+    if (sparse)
+      solve_sparse();
+    else
+      solve_dense(first_unknown, first_equation, blocks);
     points_.middleCols(first_unknown, blocks).reshaped() -= update;
     if (small(update.lpNorm<Eigen::Infinity>(), options_.tolerance,
               points_.lpNorm<Eigen::Infinity>())) {
-      action(h, Order::gradient);
+      action(h, Order::gradient, forced);
       return statistics_.record(iteration + 1);
     }
   }
@@ -242,9 +371,10 @@ void GalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double
                                       double* p1) {
   if (explicit_) return explicit_step(q0, p0, h, q1, p1);
   warm_start(q0, p0, h);
-  newton(h, 1, 0, s_, p0);
+  newton(h, 1, 0, s_, p0, !forces_.empty());
+  t_ += h;
   Eigen::Map<Eigen::VectorXd>(q1, n_) = points_.col(s_);
-  Eigen::Map<Eigen::VectorXd>(p1, n_) = gradient_.segment(s_ * n_, n_);  // p1 = D2 L_d
+  Eigen::Map<Eigen::VectorXd>(p1, n_) = gradient_.segment(s_ * n_, n_);  // p1 = D2 L_d + f_d^s
   previous_ = points_;
   previous_h_ = h;
   has_previous_ = true;
@@ -255,7 +385,7 @@ void GalerkinDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
   const Eigen::Map<const Eigen::VectorXd> a(q0, n_), b(q1, n_);
   for (int nu = 0; nu <= s_; ++nu)
     points_.col(nu) = a + basis_.control_times[nu] * (b - a);
-  if (s_ > 1) newton(h, 1, 1, s_ - 1, nullptr);
+  if (s_ > 1) newton(h, 1, 1, s_ - 1, nullptr, false);
   const double S = action(h, Order::gradient);
   if (Ld != nullptr) *Ld = S;
   if (D1 != nullptr) Eigen::Map<Eigen::VectorXd>(D1, n_) = gradient_.head(n_);

@@ -16,16 +16,8 @@ void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian
     throw std::invalid_argument("the Lagrangian's sizes do not match the manifold's dimension");
 }
 
-MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space)
-    : lagrangian_(lagrangian),
-      space_(space),
-      n_(lagrangian.velocity_size()),
-      mass_(n_, n_),
-      v_(n_),
-      gradient_(2 * n_),
-      hessian_(2 * n_, 2 * n_),
-      v_jet_(n_),
-      gradient_jet_(2 * n_) {
+EulerLagrangeField::EulerLagrangeField(LagrangianEvaluator& lagrangian)
+    : lagrangian_(lagrangian), n_(lagrangian.velocity_size()), mass_(n_, n_) {
   if (!lagrangian.plugin().constant_mass_matrix(mass_.data()))
     throw std::invalid_argument(
         "one-step methods and the shooting construction need a Lagrangian with a constant mass "
@@ -34,26 +26,21 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
   inverse_mass_ = mass_.inverse();
 }
 
-template <class F>
-Status MechanicalField::guard(F&& f) noexcept {
-  try {
-    f();
-    return nullptr;
-  } catch (const std::exception& e) {
-    message_ = e.what();
-  } catch (...) {
-    message_ = "unknown exception";
-  }
-  pending_ = std::current_exception();
-  return message_.c_str();
-}
+MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space)
+    : EulerLagrangeField(lagrangian),
+      space_(space),
+      v_(n_),
+      gradient_(2 * n_),
+      hessian_(2 * n_, 2 * n_),
+      v_jet_(n_),
+      gradient_jet_(2 * n_) {}
 
-void MechanicalField::inverse_mass(const double* w, double* x) const {
+void EulerLagrangeField::inverse_mass(const double* w, double* x) const {
   Eigen::Map<Eigen::VectorXd>(x, n_).noalias() =
       inverse_mass_ * Eigen::Map<const Eigen::VectorXd>(w, n_);
 }
 
-void MechanicalField::inverse_mass(const Jet2* w, Jet2* x) const {
+void EulerLagrangeField::inverse_mass(const Jet2* w, Jet2* x) const {
   for (int r = 0; r < n_; ++r) {
     Jet2 sum;
     for (int c = 0; c < n_; ++c)
@@ -119,7 +106,7 @@ double value_of(const Jet2& x) { return x.value; }
 }  // namespace
 
 template <class T>
-void MechanicalField::advance(OneStepMethod& method, double h, const T* y0, T* y1,
+void EulerLagrangeField::advance(OneStepMethod& method, double h, const T* y0, T* y1,
                               SolverStatistics& stages) {
   StageSolve report;
   pending_ = nullptr;
@@ -129,17 +116,17 @@ void MechanicalField::advance(OneStepMethod& method, double h, const T* y0, T* y
     throw PluginFault(std::string("one-step method: ") + status);
   }
   stages.record(report.iterations);
-  for (int r = 0; r < 2 * n_; ++r)
+  for (int r = 0; r < size(); ++r)
     if (!std::isfinite(value_of(y1[r])))
       throw NumericalFailure("the one-step method produced a non-finite state", std::nan(""));
 }
 
-void MechanicalField::step(OneStepMethod& method, double h, const double* y0, double* y1,
+void EulerLagrangeField::step(OneStepMethod& method, double h, const double* y0, double* y1,
                            SolverStatistics& stages) {
   advance(method, h, y0, y1, stages);
 }
 
-void MechanicalField::step(OneStepMethod& method, double h, const Jet2* y0, Jet2* y1,
+void EulerLagrangeField::step(OneStepMethod& method, double h, const Jet2* y0, Jet2* y1,
                            SolverStatistics& stages) {
   advance(method, h, y0, y1, stages);
 }

@@ -11,11 +11,15 @@ LagrangianEvaluator::LagrangianEvaluator(Lagrangian& lagrangian)
       n_(lagrangian.velocity_size()),
       gradient_(m_ + n_),
       residual_(n_),
-      update_(n_),
-      hessian_(m_ + n_, m_ + n_),
-      lu_(n_) {
+      update_(n_) {
   pattern_size_ = lagrangian_.hessian_pattern(&pattern_rows_, &pattern_cols_);
-  if (pattern_size_ >= 0) sparse_values_.resize(pattern_size_);
+  if (pattern_size_ >= 0) {
+    sparse_values_.resize(pattern_size_);
+    velocity_block_.resize(n_, n_);
+  } else {
+    hessian_.resize(m_ + n_, m_ + n_);
+    lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
+  }
 }
 
 void LagrangianEvaluator::check_finite(const double* values, int count, const char* what) const {
@@ -43,19 +47,29 @@ double LagrangianEvaluator::gradient(const double* q, const double* v, double* g
 
 double LagrangianEvaluator::hessian(const double* q, const double* v, double* gradient,
                                     double* hessian) {
-  double L = 0.0;
   const int k = m_ + n_;
-  if (pattern_size_ < 0) {
-    check(lagrangian_.evaluate(q, v, &L, gradient, hessian), "Lagrangian Hessian");
-  } else {
-    check(lagrangian_.evaluate(q, v, &L, gradient, sparse_values_.data()), "Lagrangian Hessian");
+  if (pattern_size_ >= 0) {
+    const double L = sparse_hessian(q, v, gradient, sparse_values_.data());
     Eigen::Map<Eigen::MatrixXd> H(hessian, k, k);
     H.setZero();
     for (int e = 0; e < pattern_size_; ++e) H(pattern_rows_[e], pattern_cols_[e]) = sparse_values_[e];
+    return L;
   }
+  double L = 0.0;
+  check(lagrangian_.evaluate(q, v, &L, gradient, hessian), "Lagrangian Hessian");
   ++counters_.hessian;
   check_finite(gradient, k, "gradient");
   check_finite(hessian, k * k, "Hessian");
+  return L;
+}
+
+double LagrangianEvaluator::sparse_hessian(const double* q, const double* v, double* gradient,
+                                           double* values) {
+  double L = 0.0;
+  check(lagrangian_.evaluate(q, v, &L, gradient, values), "Lagrangian Hessian");
+  ++counters_.hessian;
+  check_finite(gradient, m_ + n_, "gradient");
+  check_finite(values, pattern_size_, "Hessian");
   return L;
 }
 
@@ -80,18 +94,37 @@ void LagrangianEvaluator::inverse_legendre(const double* q, const double* p, dou
   const Eigen::Map<const Eigen::VectorXd> momentum(p, n_);
   double residual_norm = 0.0;
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    hessian(q, v, gradient_.data(), hessian_.data());
-    residual_ = gradient_.tail(n_) - momentum;
+    velocity_newton_update(q, v, p);
     residual_norm = residual_.lpNorm<Eigen::Infinity>();
     if (residual_norm <= options.tolerance * (1.0 + momentum.lpNorm<Eigen::Infinity>())) return;
-    lu_.compute(hessian_.bottomRightCorner(n_, n_));
-    update_.noalias() = lu_.solve(residual_);
     velocity -= update_;
     if (update_.lpNorm<Eigen::Infinity>() <=
         options.tolerance * (1.0 + velocity.lpNorm<Eigen::Infinity>()))
       return;
   }
   throw NumericalFailure("the inverse Legendre transform did not converge", residual_norm);
+}
+
+// residual_ = dL/dv (q, v) - p and the Newton update solving d2L/dv2 update = residual_; a sparse
+// Lagrangian's velocity block is assembled from its pattern and factorized by sparse LU.
+void LagrangianEvaluator::velocity_newton_update(const double* q, const double* v, const double* p) {
+  if (pattern_size_ < 0) {
+    hessian(q, v, gradient_.data(), hessian_.data());
+    lu_.compute(hessian_.bottomRightCorner(n_, n_));
+  } else {
+    sparse_hessian(q, v, gradient_.data(), sparse_values_.data());
+    triplets_.clear();
+    for (int e = 0; e < pattern_size_; ++e)
+      if (pattern_rows_[e] >= m_ && pattern_cols_[e] >= m_)
+        triplets_.emplace_back(pattern_rows_[e] - m_, pattern_cols_[e] - m_, sparse_values_[e]);
+    velocity_block_.setFromTriplets(triplets_.begin(), triplets_.end());
+    sparse_lu_.compute(velocity_block_);
+  }
+  residual_ = gradient_.tail(n_) - Eigen::Map<const Eigen::VectorXd>(p, n_);
+  if (pattern_size_ < 0)
+    update_.noalias() = lu_.solve(residual_);
+  else
+    update_ = sparse_lu_.solve(residual_);
 }
 
 double LagrangianEvaluator::energy(const double* q, const double* v) {

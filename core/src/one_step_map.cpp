@@ -1,27 +1,40 @@
 #include "varia/core/one_step_map.hpp"
 
-#include <stdexcept>
+#include "varia/core/rotation_field.hpp"
 
 namespace varia {
 
+namespace {
+
+// The Euler-Lagrange field of the manifold's phase space, y = (q, v).
+std::unique_ptr<EulerLagrangeField> tangent_field(const Manifold& manifold,
+                                                  LagrangianEvaluator& lagrangian) {
+  if (!manifold.is_vector_space()) return std::make_unique<RotationField>(manifold, lagrangian);
+  require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");
+  return std::make_unique<MechanicalField>(lagrangian, PhaseSpace::tangent);
+}
+
+}  // namespace
+
 OneStepHamiltonianMap::OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian,
                                              OneStepMethod& method, SolverOptions options)
-    : lagrangian_((require_vector_space(manifold, lagrangian, "the one-step construction"), lagrangian)),
-      field_(lagrangian_, PhaseSpace::tangent),
+    : lagrangian_(lagrangian),
+      field_(tangent_field(manifold, lagrangian_)),
       method_(method),
+      m_(manifold.point_size()),
       n_(manifold.dim()),
-      y0_(2 * n_),
-      y1_(2 * n_) {
+      y0_(m_ + n_),
+      y1_(m_ + n_) {
   method_.set_solver(options.tolerance, options.max_iterations);
 }
 
 void OneStepHamiltonianMap::step(const double* q0, const double* p0, double h, double* q1,
                                  double* p1) {
-  y0_.head(n_) = Eigen::Map<const Eigen::VectorXd>(q0, n_);
-  field_.inverse_mass(p0, y0_.data() + n_);
-  field_.step(method_, h, y0_.data(), y1_.data(), statistics_);
-  Eigen::Map<Eigen::VectorXd>(q1, n_) = y1_.head(n_);
-  Eigen::Map<Eigen::VectorXd>(p1, n_).noalias() = field_.mass() * y1_.tail(n_);
+  y0_.head(m_) = Eigen::Map<const Eigen::VectorXd>(q0, m_);
+  field_->inverse_mass(p0, y0_.data() + m_);
+  field_->step(method_, h, y0_.data(), y1_.data(), statistics_);
+  Eigen::Map<Eigen::VectorXd>(q1, m_) = y1_.head(m_);
+  Eigen::Map<Eigen::VectorXd>(p1, n_).noalias() = field_->mass() * y1_.tail(n_);
 }
 
 }  // namespace varia

@@ -76,6 +76,7 @@ Predictions predict(const Composition& c) {
 
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor) {
   OrderFit fit;
+  fit.errors = error;
   std::vector<int> kept;
   for (std::size_t k = 0; k < h.size(); ++k) {
     std::ostringstream why;
@@ -95,6 +96,16 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
         << local(1) << ")";
     fit.dropped.push_back(why.str());
     kept.erase(kept.begin());
+  }
+  // Trailing points whose local slope breaks away from the one before: a round-off plateau
+  // (the errors stop falling, or fall by chance).
+  while (kept.size() >= 4 &&
+         std::abs(local(kept.size() - 2) - local(kept.size() - 3)) > 0.3) {
+    std::ostringstream why;
+    why << "h = " << h[kept.back()] << ": at round-off (local slope " << local(kept.size() - 2)
+        << ", before it " << local(kept.size() - 3) << ")";
+    fit.dropped.push_back(why.str());
+    kept.pop_back();
   }
   fit.used = static_cast<int>(kept.size());
   if (kept.size() < 2) return fit;
@@ -145,10 +156,12 @@ double invariance_residual(DiscreteLagrangian& Ld, Lagrangian& lagrangian,
                            const std::vector<SamplePair>& pairs, double h) {
   double worst = 0.0;
   unsigned seed = 1;
+  // The action moves points; the velocities it also moves are not needed here.
+  std::vector<double> v(lagrangian.velocity_size(), 0.0), gv(v.size());
   for (const auto& pair : pairs) {
     std::vector<double> g0(pair.q0.size()), g1(pair.q1.size());
-    check(lagrangian.act(seed, pair.q0.data(), nullptr, g0.data(), nullptr), "group action");
-    check(lagrangian.act(seed, pair.q1.data(), nullptr, g1.data(), nullptr), "group action");
+    check(lagrangian.act(seed, pair.q0.data(), v.data(), g0.data(), gv.data()), "group action");
+    check(lagrangian.act(seed, pair.q1.data(), v.data(), g1.data(), gv.data()), "group action");
     ++seed;
     double original = 0.0, moved = 0.0;
     Ld.evaluate(pair.q0.data(), pair.q1.data(), h, &original, nullptr, nullptr);

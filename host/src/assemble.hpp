@@ -5,12 +5,16 @@
 #include <Eigen/Core>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "scene.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/force.hpp"
 #include "varia/core/lagrangian.hpp"
 #include "varia/core/manifold.hpp"
+#include "varia/core/one_step.hpp"
 #include "varia/core/quadrature.hpp"
+#include "varia/core/verification.hpp"
 
 namespace varia::host {
 
@@ -22,8 +26,11 @@ struct Assembly {
   std::shared_ptr<Manifold> manifold;
   std::shared_ptr<Lagrangian> lagrangian;
   std::shared_ptr<Quadrature> quadrature;  // when the construction uses one
+  std::shared_ptr<OneStepMethod> one_step;  // when the construction uses one
+  std::vector<std::shared_ptr<Force>> forces;  // system.forces
   std::unique_ptr<DiscreteHamiltonianMap> map;
   DiscreteLagrangian* discrete_lagrangian = nullptr;  // when the construction has one (in `map`)
+  Composition composition;  // what the parts declare, for `verify`'s predictions
   Eigen::VectorXd q0, p0;
   Eigen::VectorXd v0;  // set when the scene gives v or observes energy or momentum
 };

@@ -7,6 +7,7 @@
 #include <new>
 
 #include "commands.hpp"
+#include "cost.hpp"
 #include "errors.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/core/plugin_object.hpp"
@@ -56,10 +57,11 @@ struct Options {
   std::string scene;
   std::vector<std::string> scenes;
   RunOptions run;
-  std::string run_out, run_summary;
+  std::string run_out, run_summary, run_plot;
   LdOptions ld;
   bool json = false;
   std::string verify_json, cost_out;
+  CostOptions cost;
 };
 
 CLI::App* subcommand(CLI::App& app, Options& o, const char* name, const char* description, const char* example) {
@@ -81,10 +83,6 @@ void add_scene(CLI::App* sub, std::string& scene) {
 
 using Command = std::function<int()>;
 
-Command not_available(const char* name) {
-  return [name]() -> int { throw InputError(fmt::format("'{}' is not available yet", name)); };
-}
-
 void define_commands(CLI::App& app, Options& o, Command& chosen) {
   auto* plugins = subcommand(app, o, "plugins",
                              "List every plugin found: kind, type name, version, file, declared properties and "
@@ -103,10 +101,13 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
   run->add_option("--out", o.run_out, "write the trajectory CSV here (t, q0.., p0.., observables)")
       ->type_name("FILE.csv");
   run->add_option("--summary", o.run_summary, "write the run record JSON here")->type_name("FILE.json");
+  run->add_option("--plot", o.run_plot, "draw q(t) and the energy error (or p(t)) into this SVG (gnuplot)")
+      ->type_name("FILE.svg");
   run->add_flag("--quiet", o.run.quiet, "no progress line and no human summary");
   run->callback([&] {
     if (!o.run_out.empty()) o.run.out = o.run_out;
     if (!o.run_summary.empty()) o.run.summary = o.run_summary;
+    if (!o.run_plot.empty()) o.run.plot = o.run_plot;
     chosen = [&] { return command_run(o.common, o.scene, o.run); };
   });
 
@@ -129,21 +130,33 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
   validate->callback([&] { chosen = [&] { return command_validate(o.common, o.scene); }; });
 
   auto* verify = subcommand(app, o, "verify",
-                            "Check the theorem properties of the scene's discrete Lagrangian and integrator "
-                            "(not available yet).",
+                            "Check the theorem properties of the scene's discrete Lagrangian and integrator: predict "
+                            "each from the declared properties of the parts (the paper's theorems), measure it, "
+                            "and print both. Properties: self_adjoint, g_invariant, ld_order, global_order, "
+                            "momentum_conserved, symplectic, energy_bounded. Exit 1 when a predicted property "
+                            "does not hold.",
                             "Example:\n  varia verify scenes/default.json --json checks.json");
   add_scene(verify, o.scene);
   verify->add_option("--json", o.verify_json, "write the checks as JSON here")->type_name("FILE");
-  verify->callback([&] { chosen = not_available("verify"); });
+  verify->callback([&] { chosen = [&] { return command_verify(o.common, o.scene, o.verify_json); }; });
 
   auto* cost = subcommand(app, o, "cost",
                           "What accuracy costs in time: error, work and time across step sizes and methods, "
-                          "as CSV and a plot (not available yet).",
+                          "as CSV and a plot.",
                           "Example:\n  varia cost scenes/pendulum-galerkin-s1.json scenes/pendulum-galerkin-s2.json "
                           "--out cost/");
   cost->add_option("SCENE", o.scenes, "scene files")->required()->type_name("SCENE.json");
   cost->add_option("--out", o.cost_out, "write cost.csv and cost.svg in this directory")->type_name("DIR");
-  cost->callback([&] { chosen = not_available("cost"); });
+  cost->add_option("--h", o.cost.h, "the step sizes to run, comma-separated (default: the scene's step times 4, 2, "
+                                     "1, 1/2, ..., 1/16)")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->type_name("H,H,..");
+  cost->add_flag("--quiet", o.cost.quiet, "no progress line and no tables on stdout");
+  cost->callback([&] {
+    if (!o.cost_out.empty()) o.cost.out = o.cost_out;
+    chosen = [&] { return command_cost(o.common, o.scenes, o.cost); };
+  });
 }
 
 // CLI11 reports a mistyped command as "A subcommand is required"; name it instead.

@@ -6,11 +6,14 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <stdexcept>
+#include <string_view>
 
 #include "assemble.hpp"
 #include "output.hpp"
 #include "registry.hpp"
 #include "scene.hpp"
+#include "verify.hpp"
 
 namespace varia::host {
 
@@ -19,6 +22,22 @@ using nlohmann::json;
 namespace {
 
 Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
+
+// Runs a command's body with a registry of its own. A plugin fault, or a non-finite value that a
+// plugin returned, is re-thrown naming the plugin (kind, type, file) it came from (spec "Exit codes").
+template <class Body>
+int with_registry(const CommonOptions& common, Body&& body) {
+  Registry registry = make_registry(common);
+  try {
+    return body(registry);
+  } catch (const PluginFault& e) {
+    throw PluginFault(fmt::format("{}; from {}", e.what(), registry.fault_source(e.what(), false)));
+  } catch (const NumericalFailure& e) {
+    const std::string source = registry.fault_source(e.what(), true);
+    if (source.empty() || std::string_view(e.what()).find("finite") == std::string_view::npos) throw;
+    throw NumericalFailure(fmt::format("{}; from {}", e.what(), source), e.residual());
+  }
+}
 
 // Loads and assembles a scene; every InputError about it is prefixed with the scene's file name.
 struct Prepared {
@@ -33,6 +52,8 @@ Prepared prepare(const std::string& scene_file, Registry& registry) {
     return Prepared{std::move(scene), std::move(assembly)};
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", scene_file, e.what()));
+  } catch (const std::invalid_argument& e) {  // a construction refusing the parts it was given
+    throw InputError(fmt::format("{}: /method: {}", scene_file, e.what()));
   }
 }
 
@@ -132,43 +153,62 @@ int command_plugins(const CommonOptions& common, bool as_json) {
 }
 
 int command_validate(const CommonOptions& common, const std::string& scene_file) {
-  Registry registry = make_registry(common);
-  const Prepared prepared = prepare(scene_file, registry);
-  fmt::print("{}: valid ({} with {} on {}, {} steps of {})\n", scene_file, prepared.scene.construction,
-             prepared.scene.lagrangian.type, prepared.scene.manifold.type, prepared.scene.steps,
-             prepared.scene.step);
-  return 0;
+  return with_registry(common, [&](Registry& registry) {
+    const Prepared prepared = prepare(scene_file, registry);
+    fmt::print("{}: valid ({} with {} on {}, {} steps of {})\n", scene_file, prepared.scene.construction,
+               prepared.scene.lagrangian.type, prepared.scene.manifold.type, prepared.scene.steps,
+               prepared.scene.step);
+    return 0;
+  });
 }
 
 int command_run(const CommonOptions& common, const std::string& scene_file, const RunOptions& options) {
-  Registry registry = make_registry(common);
-  Prepared prepared = prepare(scene_file, registry);
-  run_scene(prepared.scene, prepared.assembly, registry, options);
-  return 0;
+  return with_registry(common, [&](Registry& registry) {
+    Prepared prepared = prepare(scene_file, registry);
+    run_scene(prepared.scene, prepared.assembly, registry, options);
+    return 0;
+  });
 }
 
 int command_ld(const CommonOptions& common, const std::string& scene_file, const LdOptions& options) {
-  Registry registry = make_registry(common);
-  Prepared prepared = prepare(scene_file, registry);
-  Assembly& a = prepared.assembly;
-  if (a.discrete_lagrangian == nullptr)
-    throw InputError(fmt::format("{}: /method/construction: construction '{}' has no discrete Lagrangian",
-                                 scene_file, prepared.scene.construction));
-  if (!(options.h > 0.0) || !std::isfinite(options.h))
-    throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
-  const Eigen::VectorXd q0 = parse_numbers(options.q0, a.map->point_size(), "--q0");
-  const Eigen::VectorXd q1 = parse_numbers(options.q1, a.map->point_size(), "--q1");
-  double ld = 0.0;
-  Eigen::VectorXd d1(a.map->dim()), d2(a.map->dim());
-  a.discrete_lagrangian->evaluate(q0.data(), q1.data(), options.h, &ld, d1.data(), d2.data());
-  if (options.json) {
-    const nlohmann::ordered_json result{{"Ld", ld}, {"D1", as_vector(d1)}, {"D2", as_vector(d2)}};
-    fmt::print("{}\n", result.dump());
+  return with_registry(common, [&](Registry& registry) {
+    Prepared prepared = prepare(scene_file, registry);
+    Assembly& a = prepared.assembly;
+    if (a.discrete_lagrangian == nullptr)
+      throw InputError(fmt::format("{}: /method/construction: construction '{}' has no discrete Lagrangian",
+                                   scene_file, prepared.scene.construction));
+    if (!(options.h > 0.0) || !std::isfinite(options.h))
+      throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
+    const Eigen::VectorXd q0 = parse_numbers(options.q0, a.map->point_size(), "--q0");
+    const Eigen::VectorXd q1 = parse_numbers(options.q1, a.map->point_size(), "--q1");
+    double ld = 0.0;
+    Eigen::VectorXd d1(a.map->dim()), d2(a.map->dim());
+    a.discrete_lagrangian->evaluate(q0.data(), q1.data(), options.h, &ld, d1.data(), d2.data());
+    if (options.json) {
+      const nlohmann::ordered_json result{{"Ld", ld}, {"D1", as_vector(d1)}, {"D2", as_vector(d2)}};
+      fmt::print("{}\n", result.dump());
+      return 0;
+    }
+    fmt::print("Ld = {}\nD1 = [{}]\nD2 = [{}]\n", ld, fmt::join(as_vector(d1), ", "),
+               fmt::join(as_vector(d2), ", "));
     return 0;
-  }
-  fmt::print("Ld = {}\nD1 = [{}]\nD2 = [{}]\n", ld, fmt::join(as_vector(d1), ", "),
-             fmt::join(as_vector(d2), ", "));
-  return 0;
+  });
+}
+
+int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file) {
+  return with_registry(common, [&](Registry& registry) {
+    Prepared prepared = prepare(scene_file, registry);
+    const auto checks = verify_scene(prepared.scene, prepared.assembly, registry);
+    fmt::print("{}", checks_table(checks));
+    if (!json_file.empty()) write_json_file(json_file, nlohmann::ordered_json(checks_json(checks)));
+    const long failures = std::count_if(checks.begin(), checks.end(), [](const auto& c) { return c.failed(); });
+    if (failures == 0) return 0;
+    std::vector<std::string> names;
+    for (const auto& c : checks)
+      if (c.failed()) names.push_back(c.name);
+    fmt::print(stderr, "varia: verify: predicted but not measured to hold: {}\n", fmt::join(names, ", "));
+    return 1;
+  });
 }
 
 }  // namespace varia::host

@@ -1,11 +1,15 @@
 #include "registry.hpp"
 
 #include <dlfcn.h>
+#include <sys/stat.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstring>
 #include <cstdlib>
+#include <cctype>
 #include <set>
 #include <string_view>
 #include <vector>  // boost/dll/library_info.hpp (Boost 1.74) uses std::vector without including it
@@ -61,6 +65,17 @@ std::vector<fs::path> so_files(const fs::path& directory) {
   }
   std::sort(files.begin(), files.end());
   return files;
+}
+
+// Why a file or directory may not be trusted to hold plugins, or "" when it may: whoever can
+// write it could make the host run their code.
+std::string distrust(const fs::path& path) {
+  struct stat status {};
+  if (::stat(path.c_str(), &status) != 0) return fmt::format("cannot be inspected: {}", std::strerror(errno));
+  if ((status.st_mode & (S_IWGRP | S_IWOTH)) == 0) return "";
+  return fmt::format("writable by group or others (mode {:04o}); plugins are loaded only from files and "
+                     "directories that only their owner can write",
+                     status.st_mode & 07777);
 }
 
 std::string dlopen_error(const fs::path& file) {
@@ -179,12 +194,22 @@ const std::vector<fs::path>& Registry::candidates() {
   if (candidates_) return *candidates_;
   candidates_.emplace();
   std::set<fs::path> seen;  // a directory named twice must not make its plugins duplicates
-  for (const auto& directory : directories_)
-    for (auto& file : so_files(directory)) {
+  for (const auto& directory : directories_) {
+    const auto files = so_files(directory);
+    const std::string directory_distrust = files.empty() ? "" : distrust(directory);
+    for (const auto& file : files) {
       std::error_code ec;
-      auto canonical = fs::weakly_canonical(file, ec);
-      if (seen.insert(ec ? file : canonical).second) candidates_->push_back(std::move(file));
+      const auto canonical = fs::weakly_canonical(file, ec);
+      if (!seen.insert(ec ? file : canonical).second) continue;
+      const std::string reason = directory_distrust.empty()
+                                     ? distrust(file)
+                                     : fmt::format("its directory {} is {}", directory.string(), directory_distrust);
+      if (reason.empty())
+        candidates_->push_back(file);
+      else
+        untrusted_.push_back(Refusal{file, "not trusted: " + reason});
     }
+  }
   return *candidates_;
 }
 
@@ -239,10 +264,23 @@ std::string Registry::valid_types(const std::string& kind) {
   return fmt::format("valid {} types are: {}", kind, fmt::join(types, ", "));
 }
 
+void Registry::check_not_refused(const std::string& kind, const std::string& type) {
+  for (const auto& refusal : untrusted_) {
+    const auto& markers = scan(refusal.file).markers;
+    const bool declares = std::any_of(markers.begin(), markers.end(), [&](const Marker& m) {
+      return m.kind == kind && m.type == type;
+    });
+    if (declares)
+      throw PluginLoadError(fmt::format("{}: {} type '{}' is in this file, which was refused: {}",
+                                        refusal.file.string(), kind, type, refusal.reason));
+  }
+}
+
 const PluginRecord& Registry::find(const std::string& kind, const std::string& type) {
   const std::string key = kind + "/" + type;
   if (const auto it = loaded_.find(key); it != loaded_.end()) return it->second->record;
   const auto files = files_declaring(kind, type);
+  if (files.empty()) check_not_refused(kind, type);
   if (files.empty()) throw InputError(fmt::format("unknown {} type '{}'; {}", kind, type, valid_types(kind)));
   if (files.size() > 1)
     throw PluginLoadError(fmt::format("{} type '{}' is provided by two files: {} and {}", kind, type,
@@ -279,7 +317,9 @@ std::shared_ptr<PluginObject> Registry::create(const std::string& kind, const st
 
 std::vector<PluginRecord> Registry::list(std::vector<Refusal>& refused) {
   std::vector<PluginRecord> records;
-  for (const auto& file : candidates()) {
+  const auto& files = candidates();
+  refused.insert(refused.end(), untrusted_.begin(), untrusted_.end());
+  for (const auto& file : files) {
     try {
       records.push_back(load(file, scan(file))->record);
     } catch (const PluginLoadError& e) {
@@ -291,5 +331,42 @@ std::vector<PluginRecord> Registry::list(std::vector<Refusal>& refused) {
 }
 
 std::vector<std::string> Registry::loaded() const { return load_order_; }
+
+namespace {
+
+// The words by which a fault message names the kind of the call that failed (core's check()).
+bool names_kind(const std::string& lower_message, const std::string& kind) {
+  static const std::map<std::string, std::vector<std::string>> words{
+      {"manifold", {"manifold", "retract", "local"}},
+      {"lagrangian", {"lagrangian", "momentum", "group action", "exact solution"}},
+      {"quadrature", {"quadrature"}},
+      {"one_step", {"one-step", "one_step", "one step"}},
+      {"effect", {"effect"}},
+      {"force", {"force"}}};
+  const auto it = words.find(kind);
+  if (it == words.end()) return false;
+  return std::any_of(it->second.begin(), it->second.end(),
+                     [&](const std::string& word) { return lower_message.find(word) != std::string::npos; });
+}
+
+std::string describe(const PluginRecord& record) {
+  return fmt::format("{} '{}' ({})", record.kind, record.type, record.file.string());
+}
+
+}  // namespace
+
+std::string Registry::fault_source(const std::string& message, bool only_named) const {
+  std::string lower = message;
+  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
+  std::vector<std::string> named, all;
+  for (const auto& [key, loaded] : loaded_) {
+    all.push_back(describe(loaded->record));
+    if (names_kind(lower, loaded->record.kind)) named.push_back(all.back());
+  }
+  if (named.size() == 1) return named.front();
+  if (!named.empty()) return fmt::format("one of: {}", fmt::join(named, ", "));
+  if (only_named || all.empty()) return "";
+  return fmt::format("one of: {}", fmt::join(all, ", "));
+}
 
 }  // namespace varia::host

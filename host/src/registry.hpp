@@ -4,6 +4,9 @@
 // (the varia_type_<kind>__<type> marker), so that a run loads only the files its scene names.
 // Loading checks varia_abi_version before importing anything else. Objects a plugin makes hold a
 // reference to its shared_library, so a library never unloads under a live object.
+// Trust: a candidate file, or a directory holding candidates, that is writable by group or others
+// is refused (never loaded, nor its symbol table read); `list()` gives the reason, and `find()`
+// names it when a scene needs a type only such a file declares.
 #pragma once
 
 #include <filesystem>
@@ -72,6 +75,10 @@ class Registry {
   }
   // Type names of the plugins loaded so far, in load order (the run record's plugins_loaded).
   std::vector<std::string> loaded() const;
+  // Which loaded plugin a fault message is about, from the kind of call it names ("Lagrangian
+  // gradient: ...", "retract: ..."): "lagrangian 'pendulum' (<file>)"; when no call kind is named,
+  // every loaded plugin ("one of: ..."), or "" when `only_named` or nothing is loaded.
+  std::string fault_source(const std::string& message, bool only_named) const;
 
  private:
   struct Loaded;
@@ -83,8 +90,12 @@ class Registry {
   std::vector<std::filesystem::path> files_declaring(const std::string& kind, const std::string& type);
   std::string valid_types(const std::string& kind);
 
+  // The error for a type that only refused (untrusted) files declare, if one does.
+  void check_not_refused(const std::string& kind, const std::string& type);
+
   std::vector<std::filesystem::path> directories_;
   std::optional<std::vector<std::filesystem::path>> candidates_;
+  std::vector<Refusal> untrusted_;  // filled with candidates_
   std::map<std::filesystem::path, SymbolScan> scans_;
   std::map<std::string, std::shared_ptr<Loaded>> loaded_;  // key: kind + "/" + type
   std::vector<std::string> load_order_;

@@ -10,6 +10,7 @@
 
 #include "observer.hpp"
 #include "output.hpp"
+#include "plot.hpp"
 #include "registry.hpp"
 
 namespace varia::host {
@@ -78,7 +79,10 @@ json run_record(const Scene& scene, const Assembly& a, const Observer& observer,
       {"wall_seconds", state.wall_seconds},
       {"newton_iterations", {{"mean", statistics.mean()}, {"max", statistics.max_iterations}}},
       {"evaluations",
-       {{"lagrangian", evaluations.lagrangian}, {"gradient", evaluations.gradient}, {"hessian", evaluations.hessian}}},
+       {{"lagrangian", evaluations.lagrangian},
+        {"gradient", evaluations.gradient},
+        {"hessian", evaluations.hessian},
+        {"force", evaluations.force}}},
       {"final", {{"t", state.t}, {"q", as_vector(state.q)}, {"p", as_vector(state.p)}}},
   };
   if (scene.observe.energy) record["energy_error_max"] = observer.energy_error();
@@ -100,6 +104,35 @@ void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, c
   fmt::print(to, "wall time         {:.4f} s\n", state.wall_seconds);
 }
 
+// The written rows, kept for `run --plot`: q(t) (up to three coordinates) beside the energy error
+// E - E0 when energy is observed, else p(t).
+class PlotRecorder {
+ public:
+  explicit PlotRecorder(bool energy) : energy_(energy) {}
+  void record(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& p, const std::vector<double>& values) {
+    const int shown = static_cast<int>(std::min<Eigen::Index>(q.size(), 3));
+    if (coordinates_.empty()) coordinates_.resize(shown), right_.resize(energy_ ? 1 : std::min<Eigen::Index>(p.size(), 3));
+    for (int i = 0; i < shown; ++i) coordinates_[i].x.push_back(t), coordinates_[i].y.push_back(q[i]);
+    for (std::size_t i = 0; i < right_.size(); ++i) {
+      if (energy_ && initial_energy_ == 0.0 && right_[0].x.empty()) initial_energy_ = values[0];
+      right_[i].x.push_back(t);
+      right_[i].y.push_back(energy_ ? values[0] - initial_energy_ : p[static_cast<Eigen::Index>(i)]);
+    }
+  }
+  void write(const std::filesystem::path& file) {
+    for (std::size_t i = 0; i < coordinates_.size(); ++i) coordinates_[i].title = fmt::format("q{}", i);
+    for (std::size_t i = 0; i < right_.size(); ++i) right_[i].title = energy_ ? "E - E0" : fmt::format("p{}", i);
+    write_svg(file, {Panel{"configuration", "t", "q", false, false, coordinates_},
+                     Panel{energy_ ? "energy error" : "momentum", "t", energy_ ? "E(t) - E(0)" : "p", false, false,
+                           right_}});
+  }
+
+ private:
+  bool energy_;
+  double initial_energy_ = 0.0;
+  std::vector<Series> coordinates_, right_;
+};
+
 class Stepper {
  public:
   Stepper(const Scene& scene, Assembly& a, const RunOptions& options)
@@ -109,7 +142,10 @@ class Stepper {
     state_.q1.resize(a.q0.size());
     state_.p1.resize(a.p0.size());
     if (options.out) csv_ = std::make_unique<CsvWriter>(*options.out);
+    if (options.plot) plot_ = std::make_unique<PlotRecorder>(scene.observe.energy);
   }
+
+  PlotRecorder* plot() { return plot_.get(); }
 
   // Runs every step; returns the failure that stopped it, if any.
   std::optional<Failure> run(bool quiet) {
@@ -140,6 +176,7 @@ class Stepper {
   }
 
   void advance() {
+    a_.map->set_time(state_.t);
     a_.map->step(state_.q.data(), state_.p.data(), scene_.step, state_.q1.data(), state_.p1.data());
     if (!finite(state_.q1) || !finite(state_.p1)) throw NumericalFailure("a non-finite state", std::nan(""));
     state_.q.swap(state_.q1);
@@ -156,6 +193,7 @@ class Stepper {
     if (csv_ && due)
       csv_->row(state_.t, state_.q.data(), static_cast<int>(state_.q.size()), state_.p.data(),
                 static_cast<int>(state_.p.size()), observer_.values());
+    if (plot_ && due) plot_->record(state_.t, state_.q, state_.p, observer_.values());
   }
 
   const Scene& scene_;
@@ -163,6 +201,7 @@ class Stepper {
   Observer observer_;
   Trajectory state_;
   std::unique_ptr<CsvWriter> csv_;
+  std::unique_ptr<PlotRecorder> plot_;
 };
 
 }  // namespace
@@ -177,6 +216,7 @@ void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry,
                          {"residual", failure->residual},
                          {"message", failure->message}};
   if (options.summary) write_json_file(*options.summary, record);
+  if (options.plot) stepper.plot()->write(*options.plot);
   if (failure)
     throw NumericalFailure(fmt::format("step {} (from t = {:.10g}) failed: {}; residual {:.3e}", failure->step,
                                        failure->t, failure->message, failure->residual),

@@ -15,6 +15,7 @@ class Registry;
 struct RunOptions {
   std::optional<std::filesystem::path> out;      // trajectory CSV ("-": stdout); none: not written
   std::optional<std::filesystem::path> summary;  // run record JSON
+  std::optional<std::filesystem::path> plot;     // SVG of q(t) and the energy error (or p(t))
   bool quiet = false;                             // no progress line, no human summary
 };
 

@@ -2,12 +2,9 @@
 
 #include <fmt/format.h>
 
-#include <cerrno>
 #include <cmath>
-#include <cstring>
-#include <fstream>
-#include <sstream>
 
+#include "json_reader.hpp"
 #include "json_schema.hpp"
 #include "registry.hpp"
 #include "scene_schema.hpp"
@@ -17,27 +14,6 @@ namespace varia::host {
 using nlohmann::json;
 
 namespace {
-
-// The line and column (1-based) of a byte offset in a text.
-std::pair<std::size_t, std::size_t> line_and_column(const std::string& text, std::size_t byte) {
-  std::size_t line = 1, column = 1;
-  for (std::size_t i = 0; i < byte && i < text.size(); ++i) {
-    if (text[i] == '\n') {
-      ++line;
-      column = 1;
-    } else {
-      ++column;
-    }
-  }
-  return {line, column};
-}
-
-// nlohmann's message without its "[json.exception...] parse error at line L, column C: " head.
-std::string parse_error_reason(const std::string& what) {
-  const auto column = what.find("column ");
-  const auto colon = column == std::string::npos ? std::string::npos : what.find(": ", column);
-  return colon == std::string::npos ? what : what.substr(colon + 2);
-}
 
 const SchemaValidator& scene_validator() {
   static const SchemaValidator validator(json::parse(kSceneSchema));
@@ -119,25 +95,11 @@ void check_size(const std::vector<double>& values, int expected, const std::stri
 
 std::vector<const PluginSpec*> Scene::plugins() const {
   std::vector<const PluginSpec*> all{&manifold, &lagrangian};
+  for (const auto& effect : effects) all.push_back(&effect);
   for (const auto& force : forces) all.push_back(&force);
   if (quadrature) all.push_back(&*quadrature);
   if (one_step) all.push_back(&*one_step);
   return all;
-}
-
-json read_json_file(const std::filesystem::path& file) {
-  std::ifstream in(file, std::ios::binary);
-  if (!in) throw InputError(fmt::format("cannot be read: {}", std::strerror(errno)));
-  std::ostringstream text;
-  text << in.rdbuf();
-  const std::string content = text.str();
-  try {
-    return json::parse(content);
-  } catch (const json::parse_error& e) {
-    const auto [line, column] = line_and_column(content, e.byte > 0 ? e.byte - 1 : 0);
-    throw InputError(
-        fmt::format("invalid JSON at line {}, column {}: {}", line, column, parse_error_reason(e.what())));
-  }
 }
 
 Scene parse_scene(const json& document) {
@@ -146,6 +108,12 @@ Scene parse_scene(const json& document) {
   const json& system = document["system"];
   scene.manifold = plugin_spec(system["manifold"], "/system/manifold", "manifold");
   scene.lagrangian = plugin_spec(system["lagrangian"], "/system/lagrangian", "lagrangian");
+  // Spec "Composed systems": each of the lagrangian's terms is an effect plugin object (checked to
+  // have a "type" by the lagrangian's parameter schema, before the effects are created).
+  const json terms = scene.lagrangian.parameters.value("terms", json::array());
+  for (std::size_t i = 0; terms.is_array() && i < terms.size(); ++i)
+    if (terms[i].is_object() && terms[i].contains("type") && terms[i]["type"].is_string())
+      scene.effects.push_back(plugin_spec(terms[i], fmt::format("/system/lagrangian/terms/{}", i), "effect"));
   const json forces = system.value("forces", json::array());
   for (std::size_t i = 0; i < forces.size(); ++i)
     scene.forces.push_back(plugin_spec(forces[i], fmt::format("/system/forces/{}", i), "force"));

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "json_reader.hpp"  // read_json_file
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/core/manifold.hpp"
 
@@ -30,6 +31,7 @@ struct Observe {
 struct Scene {
   std::string construction;  // galerkin | shooting | one-step | lie-verlet
   PluginSpec manifold, lagrangian;
+  std::vector<PluginSpec> effects;  // the lagrangian's "terms" (a composite's effects)
   std::vector<PluginSpec> forces;
   std::optional<PluginSpec> quadrature, one_step;
   int degree = 0;                                    // galerkin
@@ -48,9 +50,6 @@ struct Scene {
   std::vector<const PluginSpec*> plugins() const;
 };
 
-// Reads a JSON file; a syntax error is an InputError naming its line and column. Messages do
-// not repeat the file name: the caller prefixes it.
-nlohmann::json read_json_file(const std::filesystem::path& file);
 // Checks a scene document against the scene schema and returns its content (InputError).
 Scene parse_scene(const nlohmann::json& document);
 // Checks each plugin object's parameters against its plugin's parameter schema; an unknown type

@@ -19,7 +19,9 @@
 #include <cmath>
 #include <limits>
 #include <random>
+#include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "support.hpp"
 #include "varia/sdk/autodiff_lagrangian.hpp"

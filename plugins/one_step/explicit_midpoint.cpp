@@ -11,6 +11,7 @@ class ExplicitMidpoint final : public varia::sdk::RungeKutta {
   static constexpr const char* properties = R"({
     "order": 2,
     "self_adjoint": false,
+    "symplectic": false,
     "equivariance": "affine",
     "implicit": false
   })";

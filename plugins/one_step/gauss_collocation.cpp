@@ -42,6 +42,7 @@ class GaussCollocation final : public varia::sdk::RungeKutta {
   static constexpr const char* properties = R"({
     "order": "2*stages",
     "self_adjoint": true,
+    "symplectic": true,
     "equivariance": "affine",
     "implicit": true
   })";

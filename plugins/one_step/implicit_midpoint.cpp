@@ -13,6 +13,7 @@ class ImplicitMidpoint final : public varia::sdk::RungeKutta {
   static constexpr const char* properties = R"({
     "order": 2,
     "self_adjoint": true,
+    "symplectic": true,
     "equivariance": "affine",
     "implicit": true
   })";

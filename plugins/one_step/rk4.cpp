@@ -13,6 +13,7 @@ class Rk4 final : public varia::sdk::RungeKutta {
   static constexpr const char* properties = R"({
     "order": 4,
     "self_adjoint": false,
+    "symplectic": false,
     "equivariance": "affine",
     "implicit": false
   })";

@@ -4,6 +4,8 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <doctest/doctest.h>
+
 #include <algorithm>
 #include <atomic>
 #include <cstdlib>
@@ -29,6 +31,9 @@ class TempDir {
     path_ = fs::temp_directory_path() /
             ("varia-host-test-" + std::to_string(::getpid()) + "-" + std::to_string(counter++));
     fs::create_directories(path_);
+    // Only the owner may write it, whatever the umask: the registry refuses plugin directories
+    // that group or others can write.
+    fs::permissions(path_, fs::perms::owner_all);
   }
   ~TempDir() {
     std::error_code ec;
@@ -83,6 +88,14 @@ inline Outcome run_varia(const std::string& arguments) {
 
 inline bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
+}
+
+// Spec "Exit codes": a non-zero exit prints one line to stderr, "varia: error: ...", naming the cause.
+inline void check_one_error_line(const Outcome& outcome, const std::string& expected) {
+  const auto lines = lines_of(outcome.err);
+  REQUIRE(lines.size() == 1);
+  CHECK(lines[0].rfind("varia: error: ", 0) == 0);
+  CHECK(contains(lines[0], expected));
 }
 
 // The files of a directory with this extension, sorted.

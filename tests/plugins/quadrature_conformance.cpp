@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "plugins/load_plugin.hpp"
+#include "varia/sdk/conformance/quadrature.hpp"
 #include "varia/core/manifold.hpp"
 #include "varia/core/quadrature.hpp"
 
@@ -22,85 +23,23 @@ using varia::Quadrature;
 using varia::test::load_plugin;
 using varia::test::LoadedPlugin;
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
+using varia::sdk::conformance::check_degree;
+using varia::sdk::conformance::check_nodes_and_weights;
+using varia::sdk::conformance::Failures;
+using varia::sdk::conformance::is_symmetric;
+using varia::sdk::conformance::kEps;
+using varia::sdk::conformance::monomial_error;
+using varia::sdk::conformance::MonomialError;
+using varia::test::check_conforms;
 // Integer parameters are swept from their schema minimum up to this value.
 constexpr int kSweepLimit = 12;
-
-// Q(t^k) = sum_i b_i c_i^k + sum_j (a_j f^(j)(0) + z_j f^(j)(1)) with f = t^k (the derivative
-// terms of an Euler-Maclaurin rule, quadrature.hpp, with h = 1), in long double, beside the sum of
-// the magnitudes of its terms, which bounds the effect of rounding the rule to double.
-struct Integral {
-  long double value = 0, magnitude = 0;
-  void add(long double term) {
-    value += term;
-    magnitude += std::fabs(term);
-  }
-};
-
-// f^(j)(t) for f = t^k.
-long double monomial_derivative(int k, int j, long double t) {
-  if (j > k) return 0;
-  long double factor = 1;
-  for (int i = k - j + 1; i <= k; ++i) factor *= i;
-  return factor * std::pow(t, static_cast<long double>(k - j));
-}
-
-Integral integrate_monomial(const Quadrature& rule, int k) {
-  Integral q;
-  for (int i = 0; i < rule.size(); ++i)
-    q.add(static_cast<long double>(rule.weights()[i]) *
-          std::pow(static_cast<long double>(rule.nodes()[i]), static_cast<long double>(k)));
-  for (int j = 1; j <= rule.derivative_terms(); ++j) {
-    const double* az = rule.derivative_weights(j);
-    q.add(az[0] * monomial_derivative(k, j, 0));
-    q.add(az[1] * monomial_derivative(k, j, 1));
-  }
-  return q;
-}
-
-// |Q(t^k) - 1/(k+1)| relative to the exact 1/(k+1), and the round-off bound on it: each term
-// carries the rounding of one weight and of k factors c_i, (k + 2) eps relative at most.
-struct MonomialError {
-  double relative, roundoff;
-};
-
-MonomialError monomial_error(const Quadrature& rule, int k) {
-  const Integral q = integrate_monomial(rule, k);
-  const long double exact = 1.0L / (k + 1);
-  return {static_cast<double>(std::fabs(q.value - exact) / exact),
-          static_cast<double>((k + 2) * kEps * q.magnitude / exact)};
-}
-
-// Parameter objects to test a plugin with: {} and, for each integer parameter in its schema, every
-// value from the schema minimum to min(maximum, kSweepLimit).
-std::vector<nlohmann::json> parameter_sweep(const LoadedPlugin& plugin) {
-  std::vector<nlohmann::json> sweep{nlohmann::json::object()};
-  const auto properties = plugin.parameter_schema().value("properties", nlohmann::json::object());
-  for (const auto& [name, property] : properties.items()) {
-    if (property.value("type", "") != "integer") continue;
-    const int last = std::min(property.value("maximum", kSweepLimit), kSweepLimit);
-    for (int value = property.value("minimum", 0); value <= last; ++value)
-      sweep.push_back({{name, value}});
-  }
-  return sweep;
-}
-
-bool is_symmetric(const Quadrature& rule) {
-  const int n = rule.size();
-  for (int i = 0; i < n; ++i) {
-    const double c = rule.nodes()[i], c_mirror = rule.nodes()[n - 1 - i];
-    const double b = rule.weights()[i], b_mirror = rule.weights()[n - 1 - i];
-    if (std::fabs(c + c_mirror - 1) > kEps || std::fabs(b - b_mirror) > kEps * b) return false;
-  }
-  return true;
-}
 
 // Every quadrature plugin of the build with every parameter object of its sweep.
 template <class Check>
 void for_every_rule(const Check& check) {
   for (const auto& file : varia::test::plugin_files("quadrature")) {
     const LoadedPlugin plugin(file);
-    for (const auto& parameters : parameter_sweep(plugin)) {
+    for (const auto& parameters : varia::sdk::conformance::parameter_sweep(plugin.parameter_schema(), kSweepLimit)) {
       INFO("plugin ", file.filename().string(), " with ", parameters.dump());
       check(*plugin.create<Quadrature>(parameters));
     }
@@ -120,38 +59,18 @@ TEST_CASE("quadrature: the build has the bundled rules as plugin files") {
 TEST_CASE(
     "quadrature: every rule integrates t^k exactly for k <= degree() and not for degree()+1") {
   for_every_rule([](const Quadrature& rule) {
-    for (int k = 0; k <= rule.degree(); ++k) {
-      const MonomialError e = monomial_error(rule, k);
-      CAPTURE(k);
-      CAPTURE(e.relative);
-      CHECK(e.relative <= e.roundoff);
-    }
-    const int k = rule.degree() + 1;
-    const MonomialError e = monomial_error(rule, k);
-    CAPTURE(k);
-    CAPTURE(e.relative);
-    CHECK(e.relative > 10 * e.roundoff);
+    Failures failures;
+    check_degree(rule, failures);
+    check_conforms(failures);
   });
 }
 
 TEST_CASE(
     "quadrature: every rule has increasing nodes in [0, 1] and positive weights summing to 1") {
   for_every_rule([](const Quadrature& rule) {
-    const int n = rule.size();
-    REQUIRE(n >= 1);
-    long double sum = 0;
-    for (int i = 0; i < n; ++i) {
-      const double c = rule.nodes()[i], b = rule.weights()[i];
-      CAPTURE(i);
-      CHECK(c >= 0);
-      CHECK(c <= 1);
-      if (i > 0) CHECK(c > rule.nodes()[i - 1]);
-      // Zero weights are allowed at the endpoints only (quadrature.hpp; paper, sec. 3).
-      CHECK((b > 0 || (b == 0 && (c == 0 || c == 1))));
-      sum += b;
-    }
-    CAPTURE(static_cast<double>(sum - 1));
-    CHECK(std::fabs(sum - 1) <= n * kEps);
+    Failures failures;
+    check_nodes_and_weights(rule, failures);
+    check_conforms(failures);
   });
 }
 

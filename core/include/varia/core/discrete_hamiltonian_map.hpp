@@ -19,6 +19,7 @@ struct EvaluationCounters {
   long lagrangian = 0;
   long gradient = 0;
   long hessian = 0;
+  long force = 0;  // evaluations of the sum of the system's forces
 };
 
 // Newton statistics of the steps made so far.
@@ -53,6 +54,9 @@ class DiscreteHamiltonianMap {
   virtual int dim() const = 0;         // numbers per momentum
   // One step of size h from (q0, p0) to (q1, p1). Throws NumericalFailure.
   virtual void step(const double* q0, const double* p0, double h, double* q1, double* p1) = 0;
+  // The time at the start of the next step, for time-dependent forces (force.hpp); a map with
+  // forces advances it by h on each step. Maps without forces ignore it.
+  virtual void set_time(double /*t*/) {}
   virtual const SolverStatistics& solver_statistics() const = 0;
   virtual const EvaluationCounters& evaluations() const = 0;
 };

@@ -5,14 +5,23 @@
 //   L_d(q0, q1) = ext_{q^1..q^{s-1}} h sum_i b_i L(q(c_i h), qdot(c_i h)).
 // Its discrete Hamiltonian map solves the IDEL equations p0 = -D1 L_d, p1 = D2 L_d together with
 // the internal stationarity conditions by Newton's method with the exact Jacobian.
+// Forces (force.hpp) enter by the discrete Lagrange-d'Alembert principle (Marsden & West 2001,
+// sec. 3.2) with the discrete forces taken through the same quadrature,
+//   f_d^nu = h sum_i b_i l_nu(c_i) f(t + c_i h, q(c_i h), qdot(c_i h)),
+// added to the equation of control point nu: p0 = -D1 L_d - f_d^0, p1 = D2 L_d + f_d^s.
+// A Lagrangian with a sparse Hessian (hessian_pattern() >= 0) gets a sparse Newton Jacobian,
+// factorized by Eigen's SparseLU; no dense matrix of size n is formed.
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/force.hpp"
 #include "varia/core/manifold.hpp"
 #include "varia/core/mechanics.hpp"
 #include "varia/core/quadrature.hpp"
@@ -37,29 +46,48 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // The manifold must be a vector space (is_vector_space()); Lie groups use their natural chart
   // through the same interface once the manifold provides it.
   GalerkinDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian, Quadrature& quadrature,
-                             std::vector<double> control_times, SolverOptions options);
+                             std::vector<double> control_times, SolverOptions options,
+                             std::vector<Force*> forces = {});
   int degree() const { return static_cast<int>(basis_.control_times.size()) - 1; }
 
-  // L_d, D1 L_d, D2 L_d with the internal control points extremized (any output may be null).
+  // L_d, D1 L_d, D2 L_d with the internal control points extremized (any output may be null);
+  // the forces are not part of L_d.
   void evaluate(const double* q0, const double* q1, double h, double* Ld, double* D1,
                 double* D2) override;
   int point_size() const override { return n_; }
   int dim() const override { return n_; }
   void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
+  void set_time(double t) override { t_ = t; }
   const SolverStatistics& solver_statistics() const override { return statistics_; }
-  const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
+  const EvaluationCounters& evaluations() const override;
   // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).
   const std::vector<double>& last_residuals() const { return residuals_; }
 
  private:
   enum class Order { value, gradient, hessian };
   // The discrete action S(q^0..q^s) = h sum_i b_i L(q(c_i h), qdot(c_i h)) of the control points
-  // in points_, with its gradient dS/dq^nu in gradient_ and Hessian in hessian_ up to `order`.
-  double action(double h, Order order);
+  // in points_, with its gradient dS/dq^nu in gradient_ and Hessian in hessian_ (sparse: in
+  // sparse_.matrix) up to `order`; with `forced`, f_d^nu is added to gradient_ and its Jacobian to
+  // the Hessian.
+  double action(double h, Order order, bool forced = false);
+  // The interpolant at quadrature node i: q_, v_.
+  void interpolate(int i, double h);
+  void add_forces(int i, double h, Order order);
+  // dq_i/dq^nu = l_nu(c_i), dv_i/dq^nu = l'_nu(c_i)/h: the weight of an entry's row or column.
+  double weight(int i, int nu, bool by_v, double h) const;
+  // Adds w * values[k] times the row and column weights to d(equation nu)/dq^mu of every block of
+  // the sparse Jacobian, for the entries [first_entry, first_entry + count).
+  void add_sparse_entries(int i, double h, int first_entry, const double* values, int count, double w);
   // Newton's method on the control points [first_unknown, first_unknown + blocks) for the
-  // equations dS/dq^nu = 0, nu in [first_equation, first_equation + blocks), where p0 (if not
-  // null) is added to the equation nu = 0 (IDEL: p0 + D1 L_d = 0).
-  void newton(double h, int first_unknown, int first_equation, int blocks, const double* p0);
+  // equations dS/dq^nu (+ f_d^nu when forced) = 0, nu in [first_equation, first_equation + blocks),
+  // where p0 (if not null) is added to the equation nu = 0 (IDEL: p0 + D1 L_d + f_d^0 = 0).
+  void newton(double h, int first_unknown, int first_equation, int blocks, const double* p0,
+              bool forced);
+  // Solves J update = residual with the Jacobian block of the current equations and unknowns.
+  void solve_dense(int first_unknown, int first_equation, int blocks);
+  void solve_sparse();
+  // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
+  void prepare_sparse(int first_unknown, int first_equation, int blocks);
   void warm_start(const double* q0, const double* p0, double h);
   // Degree 1 with nodes only at 0 and 1 and a constant mass matrix M: the IDEL equations are
   // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton.
@@ -67,8 +95,11 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void explicit_step(const double* q0, const double* p0, double h, double* q1, double* p1);
 
   LagrangianEvaluator lagrangian_;
+  Forces forces_;
+  double t_ = 0.0;  // the time at the start of the next step
+  mutable EvaluationCounters counters_;
   LagrangeBasis basis_;
-  Eigen::VectorXd weights_;
+  Eigen::VectorXd weights_, nodes_;
   Eigen::MatrixXd extrapolation_;  // l_mu(1 + d_nu): the last step's curve continued
   SolverOptions options_;
   SolverStatistics statistics_;
@@ -82,6 +113,24 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::MatrixXd hess_, hessian_, jacobian_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   std::vector<double> residuals_;
+  // The entries of a Hessian of L, then of the forces' Jacobian, as (row, col) in an n x n block
+  // with whether the row and column differentiate by v (else by q).
+  struct Entry {
+    int row, col;
+    bool row_v, col_v;
+  };
+  std::vector<Entry> entries_;
+  Eigen::VectorXd sparse_values_, force_values_, f_;
+  // The sparse Newton Jacobian: slots[(entry * equations + nu) * unknowns + mu] is the index of
+  // that entry's block (nu, mu) in matrix.valuePtr().
+  struct SparseJacobian {
+    int first_unknown = -1, first_equation = -1, blocks = 0;
+    Eigen::SparseMatrix<double> matrix;
+    std::vector<int> slots;
+    Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+    bool analyzed = false;
+  };
+  SparseJacobian sparse_;
   // The explicit form: endpoint weights, the factorized mass matrix, and dL/dq at the last q1
   // (reused as dL/dq at the next q0: one gradient evaluation per step).
   bool explicit_ = false;

@@ -27,14 +27,14 @@ enum class PhaseSpace { tangent, cotangent };
 void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian,
                           const char* construction);
 
-class MechanicalField final : public VectorField {
+// The Euler-Lagrange vector field of a Lagrangian L = 1/2 v^T M v - V(q) with a constant mass
+// matrix M, on a state y = (q, w): q the point (point_size numbers), w the velocity or momentum.
+// It drives one step of a one-step plugin, turning its Status into the right exception; the
+// derived fields give f for their phase space.
+class EulerLagrangeField : public VectorField {
  public:
   // Throws std::invalid_argument unless the Lagrangian declares a constant mass matrix.
-  MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space);
-  int size() const noexcept override { return 2 * n_; }
-  Status eval(const double* y, double* f) noexcept override;
-  Status eval(const Jet2* y, Jet2* f) noexcept override;
-  Status jacobian(const double* y, double* f, double* df) noexcept override;
+  explicit EulerLagrangeField(LagrangianEvaluator& lagrangian);
 
   // y1 = Psi_h(y0) by `method`, its stage iterations recorded in `stages`. Throws
   // NumericalFailure (stage equations that do not converge, a non-finite state) or PluginFault.
@@ -46,21 +46,50 @@ class MechanicalField final : public VectorField {
   // x = M^{-1} w, at doubles or jets: the velocity of a momentum, the acceleration of a force.
   void inverse_mass(const double* w, double* x) const;
   void inverse_mass(const Jet2* w, Jet2* x) const;
+
+ protected:
+  // Runs f, turning an exception into a Status (kept to be rethrown after the step).
+  template <class F>
+  Status guard(F&& f) noexcept {
+    try {
+      f();
+      return nullptr;
+    } catch (const std::exception& e) {
+      message_ = e.what();
+    } catch (...) {
+      message_ = "unknown exception";
+    }
+    pending_ = std::current_exception();
+    return message_.c_str();
+  }
+
+  LagrangianEvaluator& lagrangian_;
+  int n_;
+  Eigen::MatrixXd mass_, inverse_mass_;
+
+ private:
+  template <class T>
+  void advance(OneStepMethod& method, double h, const T* y0, T* y1, SolverStatistics& stages);
+
+  std::exception_ptr pending_;  // what made the last callback fail, rethrown after the step
+  std::string message_;
+};
+
+// On R^n: y = (q, v) or (q, p), N = 2n.
+class MechanicalField final : public EulerLagrangeField {
+ public:
+  // Throws std::invalid_argument unless the Lagrangian declares a constant mass matrix.
+  MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space);
+  int size() const noexcept override { return 2 * n_; }
+  Status eval(const double* y, double* f) noexcept override;
+  Status eval(const Jet2* y, Jet2* f) noexcept override;
+  Status jacobian(const double* y, double* f, double* df) noexcept override;
+
   // The velocity of a state's second half: v = w (tangent) or M^{-1} w (cotangent).
   void velocity(const Jet2* w, Jet2* v) const;
 
  private:
-  template <class F>
-  Status guard(F&& f) noexcept;
-  template <class T>
-  void advance(OneStepMethod& method, double h, const T* y0, T* y1, SolverStatistics& stages);
-
-  LagrangianEvaluator& lagrangian_;
   PhaseSpace space_;
-  int n_;
-  Eigen::MatrixXd mass_, inverse_mass_;
-  std::exception_ptr pending_;  // what made the last callback fail, rethrown after the step
-  std::string message_;
   // Workspace, sized once.
   Eigen::VectorXd v_, gradient_;
   Eigen::MatrixXd hessian_;

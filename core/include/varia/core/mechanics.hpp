@@ -4,6 +4,9 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <Eigen/SparseCore>
+#include <Eigen/SparseLU>
+#include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/core/jet.hpp"
@@ -24,6 +27,12 @@ class LagrangianEvaluator {
   double gradient(const double* q, const double* v, double* gradient);
   // hessian: (m+n)^2 numbers, dense column-major (sparse Lagrangians are expanded).
   double hessian(const double* q, const double* v, double* gradient, double* hessian);
+  // A sparse Lagrangian's Hessian values, one per entry of its pattern (pattern_rows/cols).
+  double sparse_hessian(const double* q, const double* v, double* gradient, double* values);
+  bool sparse() const { return pattern_size_ >= 0; }
+  int pattern_size() const { return pattern_size_; }
+  const int* pattern_rows() const { return pattern_rows_; }
+  const int* pattern_cols() const { return pattern_cols_; }
   // L (if value is not null) and its m + n gradient numbers at jet inputs. Counted as a Hessian
   // evaluation: it carries second-order information.
   void gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient);
@@ -38,6 +47,8 @@ class LagrangianEvaluator {
 
  private:
   void check_finite(const double* values, int count, const char* what) const;
+  // One Newton step of the inverse Legendre transform: residual_ and update_ (see the .cpp).
+  void velocity_newton_update(const double* q, const double* v, const double* p);
   Lagrangian& lagrangian_;
   int m_, n_;
   const int* pattern_rows_ = nullptr;
@@ -45,8 +56,11 @@ class LagrangianEvaluator {
   int pattern_size_ = -1;
   // Workspace, sized once: an evaluation allocates nothing.
   Eigen::VectorXd sparse_values_, gradient_, residual_, update_;
-  Eigen::MatrixXd hessian_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  Eigen::MatrixXd hessian_;                 // dense Lagrangians only
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;  // dense Lagrangians only
+  Eigen::SparseMatrix<double> velocity_block_;  // sparse Lagrangians: d2L/dv2
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> sparse_lu_;
+  std::vector<Eigen::Triplet<double>> triplets_;
   EvaluationCounters counters_;
 };
 

@@ -19,6 +19,28 @@ class VectorField {
   virtual Status eval(const Jet2* y, Jet2* f) noexcept = 0;
   // f(y) and its exact Jacobian df/dy (N x N, column-major): the Newton matrix of implicit stages.
   virtual Status jacobian(const double* y, double* f, double* df) noexcept = 0;
+
+  // The state space as a Lie group acting on itself, for Lie group methods (Crouch-Grossman,
+  // RKMK; paper, sec. 2 "G-equivariant interpolants"): y' = y . xi(y) with xi(y) in the algebra
+  // (algebra_size() numbers), and move(y, xi) = y . exp(xi). The defaults are those of R^N, the
+  // group of translations: xi = f, y . exp(xi) = y + xi; a Lie group method is then a Runge-Kutta
+  // method. On TSO(3) = SO(3) x R^3 the field gives xi = (Omega, Omega') and moves R exp(Omega).
+  virtual int algebra_size() const noexcept { return size(); }
+  virtual Status algebra(const double* y, double* xi) noexcept { return eval(y, xi); }
+  virtual Status algebra(const Jet2* y, Jet2* xi) noexcept { return eval(y, xi); }
+  virtual Status move(const double* y, const double* xi, double* moved) noexcept {
+    return translate(y, xi, moved);
+  }
+  virtual Status move(const Jet2* y, const Jet2* xi, Jet2* moved) noexcept {
+    return translate(y, xi, moved);
+  }
+
+ private:
+  template <class T>
+  Status translate(const T* y, const T* xi, T* moved) noexcept {
+    for (int r = 0; r < size(); ++r) moved[r] = y[r] + xi[r];
+    return nullptr;
+  }
 };
 
 // What an implicit method reports about the nonlinear solves of one step (zeros for explicit
@@ -36,7 +58,8 @@ class OneStepMethod : public PluginObject {
   // The order p of the global error, whether Psi_h is self-adjoint (Psi_h = Psi_{-h}^{-1}, paper,
   // sec. 3 "Symmetric shooting-based discrete Lagrangians"), and the maps of R^N it commutes
   // with ("affine" for Runge-Kutta methods: every tangent-lifted linear or affine group action
-  // on R^n, paper, sec. 3 "Group-invariant shooting-based discrete Lagrangians").
+  // on R^n, paper, sec. 3 "Group-invariant shooting-based discrete Lagrangians"; "left" for Lie
+  // group methods: left multiplication on the group, and affine maps where the group is R^N).
   virtual int order() const noexcept = 0;
   virtual bool self_adjoint() const noexcept = 0;
   virtual const char* equivariance() const noexcept = 0;

@@ -1,10 +1,14 @@
 // A one-step method run directly on the Euler-Lagrange equations (the scene's construction
 // "one-step"): the comparison methods of the paper's examples (sec. 3, "Examples": the implicit
 // midpoint rule MID, the 2-stage Gauss method SRK4). (q0, p0) -> (q0, v0 = M^{-1} p0), one step
-// of Psi_h on TQ, then p1 = M v1. Not variational unless the method is symplectic.
+// of Psi_h on TQ, then p1 = M v1. Not variational unless the method is symplectic. On R^n the
+// field is the MechanicalField; on SO(3) the RotationField, y = (R, Omega): Runge-Kutta methods
+// integrate it in the embedding R^9 x R^3, Lie group methods on the group (paper, sec. 2,
+// Figure 1: RK, SRK, LGM).
 #pragma once
 
 #include <Eigen/Core>
+#include <memory>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/core/manifold.hpp"
@@ -16,11 +20,11 @@ namespace varia {
 
 class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
  public:
-  // Throws std::invalid_argument unless the manifold is a vector space and the Lagrangian has a
-  // constant mass matrix.
+  // Throws std::invalid_argument unless the manifold is a vector space or SO(3), and the
+  // Lagrangian has a constant mass matrix.
   OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian, OneStepMethod& method,
                         SolverOptions options);
-  int point_size() const override { return n_; }
+  int point_size() const override { return m_; }
   int dim() const override { return n_; }
   void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
   // The method's stage solves (zeros for explicit methods).
@@ -29,9 +33,9 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
 
  private:
   LagrangianEvaluator lagrangian_;
-  MechanicalField field_;
+  std::unique_ptr<EulerLagrangeField> field_;
   OneStepMethod& method_;
-  int n_;
+  int m_, n_;  // point size, dimension
   SolverStatistics statistics_;
   Eigen::VectorXd y0_, y1_;
 };

@@ -11,7 +11,9 @@
 namespace varia {
 
 // Bumped whenever a virtual interface below or in the kind headers changes layout.
-inline constexpr int kAbiVersion = 3;  // 2: Lagrangian::gradient_jet, OneStepMethod; 3: Manifold::constraint_error
+// 2: Lagrangian::gradient_jet, OneStepMethod; 3: Manifold::constraint_error; 4: VectorField's
+// Lie group hooks (algebra, move).
+inline constexpr int kAbiVersion = 4;
 
 using Status = const char*;
 

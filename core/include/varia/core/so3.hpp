@@ -23,13 +23,15 @@ using Matrix3 = Eigen::Matrix<T, 3, 3>;
 
 inline constexpr double kSeriesBound = 0.25;  // theta < 1/2
 
-// The real part of a scalar (nested autodiff scalars and jets expose value()).
+// The real part of a scalar (nested autodiff scalars expose value(), Jet2 the member value).
 template <class T>
 double real(const T& x) {
   if constexpr (std::is_arithmetic_v<T>)
     return static_cast<double>(x);
-  else
+  else if constexpr (requires { x.value(); })
     return real(x.value());
+  else
+    return x.value;
 }
 
 template <class T>

@@ -42,12 +42,14 @@ struct Predictions {
 Predictions predict(const Composition& composition);
 
 // A least-squares slope of log(error) against log(h) that drops points at round-off (error below
-// `floor`) and pre-asymptotic points (leading points whose local slope differs from the next by
-// more than 0.3), saying why for each.
+// `floor`), pre-asymptotic points (leading points whose local slope differs from the next by
+// more than 0.3) and a round-off plateau (trailing points whose local slope breaks away from the
+// one before by more than 0.3), saying why for each.
 struct OrderFit {
   double slope = 0.0;
   int used = 0;
   std::vector<std::string> dropped;
+  std::vector<double> errors;  // all the errors, fitted or not
 };
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor);
 

@@ -4,13 +4,16 @@
 //
 //   template <class T> T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const;
 //
-// Derivative vectors have a fixed capacity, so an evaluation allocates nothing. The same model,
+// Derivative vectors have a fixed capacity, so an evaluation allocates nothing; for the common
+// sizes m + n = 2, 4, 6, 12 (Rn of dim 1, 2, 3; SO3) they have a fixed size, so the arithmetic
+// is unrolled and a second-order scalar holds (k+1)^2 doubles instead of 17^2. The same model,
 // evaluated at a dual number over second-order jets, gives gradient_jet (at most
 // kMaxJetVariables position and velocity numbers together).
 #pragma once
 
 #include <Eigen/Core>
 #include <string>
+#include <type_traits>
 #include <unsupported/Eigen/AutoDiff>
 
 #include "varia/core/lagrangian.hpp"
@@ -23,6 +26,11 @@ template <class T>
 using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, kMaxAutodiffVariables, 1>;
 using Dual = Eigen::AutoDiffScalar<Vec<double>>;
 using Dual2 = Eigen::AutoDiffScalar<Vec<Dual>>;
+// The fixed-size counterparts for m + n = K (Eigen's AutoDiffScalar takes any derivative vector).
+template <int K>
+using FixedDual = Eigen::AutoDiffScalar<Eigen::Matrix<double, K, 1>>;
+template <int K>
+using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
 // First derivatives at jet inputs (Lagrangian::gradient_jet): at most kMaxJetVariables numbers
 // m + n, which keeps a Vec of these scalars within Eigen's stack allocation limit.
 using JetDual = Eigen::AutoDiffScalar<
@@ -44,9 +52,11 @@ class AutodiffLagrangian : public Lagrangian {
                   double* hessian) noexcept final {
     return guarded(error_, [&] {
       if (hessian != nullptr)
-        second_order(q, v, value, gradient, hessian);
+        dispatch([&](auto, auto second) {
+          second_order<typename decltype(second)::type>(q, v, value, gradient, hessian);
+        });
       else if (gradient != nullptr)
-        first_order(q, v, value, gradient);
+        dispatch([&](auto first, auto) { first_order<typename decltype(first)::type>(q, v, value, gradient); });
       else if (value != nullptr)
         *value = model().lagrangian(Vec<double>(Eigen::Map<const Vec<double>>(q, m_)),
                                     Vec<double>(Eigen::Map<const Vec<double>>(v, n_)));
@@ -78,38 +88,60 @@ class AutodiffLagrangian : public Lagrangian {
   const Model& model() const { return static_cast<const Model&>(*this); }
   double at(const double* q, const double* v, int k) const { return k < m_ ? q[k] : v[k - m_]; }
 
+  // Calls f with tags (std::type_identity) of the first- and second-order scalar types for
+  // k = m + n: fixed-size
+  // where k is one of the common sizes, else the capacity-bounded dynamic ones.
+  template <class T>
+  using Tag = std::type_identity<T>;
+  template <class F>
+  void dispatch(F&& f) const {
+    switch (m_ + n_) {
+      case 2: return f(Tag<FixedDual<2>>(), Tag<FixedDual2<2>>());
+      case 4: return f(Tag<FixedDual<4>>(), Tag<FixedDual2<4>>());
+      case 6: return f(Tag<FixedDual<6>>(), Tag<FixedDual2<6>>());
+      case 12: return f(Tag<FixedDual<12>>(), Tag<FixedDual2<12>>());
+      default: return f(Tag<Dual>(), Tag<Dual2>());
+    }
+  }
+
+  // L and its gradient by forward mode: one derivative direction per number of (q, v).
+  template <class D>
   void first_order(const double* q, const double* v, double* value, double* gradient) const {
     const int k = m_ + n_;
-    Vec<Dual> qd(m_), vd(n_);
+    Vec<D> qd(m_), vd(n_);
     for (int i = 0; i < k; ++i) {
-      Dual z(at(q, v, i), k, i);
+      D z(at(q, v, i), k, i);
       (i < m_ ? qd(i) : vd(i - m_)) = z;
     }
-    const Dual r = model().lagrangian(qd, vd);
+    const D r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value();
     for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : 0.0;
   }
 
+  // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).
+  template <class D2>
   void second_order(const double* q, const double* v, double* value, double* gradient,
                     double* hessian) const {
+    using D = typename D2::Scalar;
+    using Inner = typename D::DerType;
     const int k = m_ + n_;
-    Vec<Dual2> qd(m_), vd(n_);
+    Vec<D2> qd(m_), vd(n_);
     for (int i = 0; i < k; ++i) {
-      Dual2 z;
-      z.value() = Dual(at(q, v, i), k, i);
+      D2 z;
+      z.value() = D(at(q, v, i), k, i);
       z.derivatives().resize(k);
-      for (int j = 0; j < k; ++j) z.derivatives()(j) = Dual(i == j ? 1.0 : 0.0, Vec<double>::Zero(k));
+      for (int j = 0; j < k; ++j) z.derivatives()(j) = D(i == j ? 1.0 : 0.0, Inner::Zero(k));
       (i < m_ ? qd(i) : vd(i - m_)) = z;
     }
-    const Dual2 r = model().lagrangian(qd, vd);
+    const D2 r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value().value();
     const bool has_first = r.value().derivatives().size() == k;
     const bool has_second = r.derivatives().size() == k;
     for (int i = 0; i < k; ++i) {
       if (gradient != nullptr) gradient[i] = has_first ? r.value().derivatives()(i) : 0.0;
       for (int j = 0; j < k; ++j) {
-        const auto& dj = has_second ? r.derivatives()(j).derivatives() : Vec<double>();
-        hessian[j * k + i] = dj.size() == k ? dj(i) : 0.0;
+        const bool has = has_second && r.derivatives()(j).derivatives().size() == k;
+        hessian[j * k + i] = has ? r.derivatives()(j).derivatives()(i) : 0.0;
       }
     }
   }

@@ -1,0 +1,55 @@
+// The composite Lagrangian of a particle system (spec: "Composed systems: effects"): N particles
+// in d dimensions, q = (x_0, ..., x_{N-1}) with x_i = q[i d .. i d + d), and
+//   L(q, v) = 1/2 sum_i m_i |v_i|^2 - sum_e V_e(q),
+// the potentials V_e being Effect objects (effect.hpp), each over the coordinates it names. The
+// Hessian is sparse (hessian_pattern()): the diagonal mass block and the union of the effects'
+// Hessian entries, so that a chain of springs has a banded Hessian.
+// Built here, in core, from the masses and the effect objects: the host creates the effects from
+// the scene's "terms" and hands them in; no plugin calls another.
+#pragma once
+
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "varia/core/effect.hpp"
+#include "varia/core/lagrangian.hpp"
+
+namespace varia {
+
+class CompositeLagrangian : public Lagrangian {
+ public:
+  // Binds each effect to the system; throws std::invalid_argument whose message starts with the
+  // parameter at fault, relative to the composite ("terms/2: ...", "masses: ...").
+  CompositeLagrangian(int space_dim, std::vector<double> masses,
+                      std::vector<std::shared_ptr<Effect>> effects);
+  int position_size() const noexcept final { return n_; }
+  int velocity_size() const noexcept final { return n_; }
+  Status evaluate(const double* q, const double* v, double* value, double* gradient,
+                  double* hessian) noexcept final;
+  int hessian_pattern(const int** rows, const int** cols) const noexcept final;
+  bool constant_mass_matrix(double* mass) const noexcept final;
+
+ private:
+  // One effect with its gathered coordinates and where its Hessian entries go in the pattern.
+  struct Term {
+    std::shared_ptr<Effect> effect;
+    const int* indices = nullptr;
+    std::vector<int> slots;
+    std::vector<double> x, gradient, hessian;
+  };
+  using Slots = std::map<std::pair<int, int>, int>;
+  Term bind(std::shared_ptr<Effect> effect, std::size_t index, Slots& slots);
+  // The slot of entry (row, col) in the pattern, appended when new.
+  int slot(int row, int col, Slots& slots);
+  void add_term(Term& term, const double* q, double* value, double* gradient, double* hessian);
+
+  int d_, n_;
+  std::vector<double> masses_;  // one per coordinate: m_i repeated d times
+  std::vector<Term> terms_;
+  std::vector<int> rows_, cols_;
+  std::string error_;
+};
+
+}  // namespace varia

@@ -1,0 +1,33 @@
+// `varia verify` (spec: "Commands", "Outputs"): predicts each property of the scene's integrator
+// from the declared properties of its parts by the paper's theorems, measures it, and reports
+// both.
+#pragma once
+
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "assemble.hpp"
+#include "scene.hpp"
+
+namespace varia::host {
+
+class Registry;
+
+struct PropertyCheck {
+  std::string name;
+  nlohmann::json predicted;  // true, false, an order, or null where the theorems say nothing
+  std::optional<bool> holds;     // null: not measured for this construction
+  std::optional<double> measured;
+  double tolerance = 0.0;
+  std::string note;              // how it was measured, points dropped from a fit
+  // A property the theorems predict that was measured not to hold (exit code 1).
+  bool failed() const;
+};
+
+std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& assembly, Registry& registry);
+nlohmann::json checks_json(const std::vector<PropertyCheck>& checks);
+std::string checks_table(const std::vector<PropertyCheck>& checks);
+
+}  // namespace varia::host

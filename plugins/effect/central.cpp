@@ -1,0 +1,63 @@
+// A central (Kepler) attraction of one particle of mass m to a fixed center c:
+// V = -mu m / |d|, d = x - c; dV/dx = mu m d / |d|^3, d2V/dx2 = mu m (I / |d|^3 - 3 d d^T / |d|^5).
+#include <cmath>
+
+#include "../lagrangian/support.hpp"
+#include "support.hpp"
+
+namespace {
+
+class Central final : public varia::plugins::ParticleEffect {
+ public:
+  static constexpr const char* version = "1.0.0";
+  static constexpr const char* parameter_schema = R"json({
+    "$schema": "http://json-schema.org/draft-07/schema#",
+    "type": "object",
+    "properties": {
+      "mu": {"type": "number", "exclusiveMinimum": 0, "default": 1, "description": "mu in V = -mu m / |x - c|"},
+      "particle": {"type": "integer", "minimum": 0, "description": "the attracted particle"},
+      "center": {"type": "array", "items": {"type": "number"}, "minItems": 1,
+                 "description": "the fixed center c, space_dim numbers (default: the origin)"}
+    },
+    "required": ["particle"],
+    "additionalProperties": false
+  })json";
+  static constexpr const char* properties = R"json({
+    "potential": "-mu m_i / |x_i - center|",
+    "coordinates": "the particle named"
+  })json";
+
+  Central(const nlohmann::json& parameters, const varia::sdk::Context&)
+      : mu_(varia::plugins::positive_parameter(parameters, "mu", 1.0)),
+        particle_(varia::plugins::particle_index(parameters.at("particle"), "particle")),
+        center_(varia::plugins::vector_parameter(parameters, "center")) {}
+
+ private:
+  void attach() override {
+    if (center_.empty()) center_.assign(d_, 0.0);
+    check_space_vector(center_, "center");
+    use_particle(particle_, "particle");
+    dense_pattern();
+  }
+
+  void potential(const double* x, double* value, double* gradient, double* hessian) const override {
+    const Eigen::VectorXd d =
+        Eigen::Map<const Eigen::VectorXd>(x, d_) - Eigen::Map<const Eigen::VectorXd>(center_.data(), d_);
+    const double r = d.norm();
+    if (r == 0.0) throw std::domain_error("a particle is at the center of a central attraction");
+    const double k = mu_ * masses_[particle_];
+    if (value != nullptr) *value = -k / r;
+    if (gradient != nullptr) Eigen::Map<Eigen::VectorXd>(gradient, d_) = k / (r * r * r) * d;
+    if (hessian != nullptr)
+      Eigen::Map<Eigen::MatrixXd>(hessian, d_, d_) =
+          k / (r * r * r) * (Eigen::MatrixXd::Identity(d_, d_) - 3.0 / (r * r) * d * d.transpose());
+  }
+
+  double mu_;
+  int particle_;
+  std::vector<double> center_;
+};
+
+}  // namespace
+
+VARIA_PLUGIN(Central, effect, central)

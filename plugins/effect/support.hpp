@@ -1,0 +1,96 @@
+// What the effect plugins share (core/include/varia/core/effect.hpp): the bound system, the
+// coordinates of the particles an effect names, a dense Hessian pattern over them, and the
+// boundary rule (exceptions become Status messages).
+#pragma once
+
+#include <Eigen/Core>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "varia/core/effect.hpp"
+#include "varia/sdk/plugin.hpp"
+
+namespace varia::plugins {
+
+// A parameter value that names a particle: a non-negative integer (`name`: the parameter's name).
+inline int particle_index(const nlohmann::json& value, const char* name) {
+  if (!value.is_number_integer() || value.get<long>() < 0)
+    throw std::invalid_argument(std::string("parameter '") + name + "' must be a particle index >= 0, got " +
+                                value.dump());
+  return value.get<int>();
+}
+
+// A parameter that is a vector of numbers, or `fallback` when absent.
+inline std::vector<double> vector_parameter(const nlohmann::json& parameters, const char* key,
+                                            std::vector<double> fallback = {}) {
+  if (!parameters.contains(key)) return fallback;
+  const auto& value = parameters.at(key);
+  if (!value.is_array()) throw std::invalid_argument(std::string("parameter '") + key + "' must be an array of numbers");
+  for (const auto& x : value)
+    if (!x.is_number()) throw std::invalid_argument(std::string("parameter '") + key + "' must be an array of numbers");
+  return value.get<std::vector<double>>();
+}
+
+class ParticleEffect : public Effect {
+ public:
+  Status bind(int space_dim, int particles, const double* masses) noexcept final {
+    return sdk::guarded(error_, [&] {
+      d_ = space_dim;
+      particles_ = particles;
+      masses_.assign(masses, masses + particles);
+      attach();
+    });
+  }
+  int coordinates(const int** indices) const noexcept final {
+    *indices = indices_.data();
+    return static_cast<int>(indices_.size());
+  }
+  int hessian_pattern(const int** rows, const int** cols) const noexcept final {
+    *rows = rows_.data();
+    *cols = cols_.data();
+    return static_cast<int>(rows_.size());
+  }
+  Status evaluate(const double* x, double* value, double* gradient, double* hessian) noexcept final {
+    return sdk::guarded(error_, [&] { potential(x, value, gradient, hessian); });
+  }
+
+ protected:
+  // Chooses the coordinates (use_particle) and the Hessian pattern (dense_pattern) once bound.
+  virtual void attach() = 0;
+  // V, dV/dx and the Hessian values (in pattern order) at the gathered coordinates.
+  virtual void potential(const double* x, double* value, double* gradient, double* hessian) const = 0;
+
+  // Appends particle i's d coordinates; `key` names the parameter that named it.
+  void use_particle(int i, const char* key) {
+    if (i >= particles_)
+      throw std::invalid_argument(std::string(key) + ": particle " + std::to_string(i) + " does not exist (the system has " +
+                                  std::to_string(particles_) + ")");
+    for (int k = 0; k < d_; ++k) indices_.push_back(i * d_ + k);
+  }
+  // Every entry of the k x k Hessian, column-major: the values are a dense matrix.
+  void dense_pattern() {
+    const int k = static_cast<int>(indices_.size());
+    for (int c = 0; c < k; ++c)
+      for (int r = 0; r < k; ++r) {
+        rows_.push_back(r);
+        cols_.push_back(c);
+      }
+  }
+  // A parameter vector of the space's dimension d.
+  void check_space_vector(const std::vector<double>& x, const char* key) const {
+    if (static_cast<int>(x.size()) != d_)
+      throw std::invalid_argument(std::string("parameter '") + key + "' must have space_dim = " + std::to_string(d_) +
+                                  " numbers, got " + std::to_string(x.size()));
+  }
+
+  int d_ = 0, particles_ = 0;
+  std::vector<double> masses_;
+
+ private:
+  std::vector<int> indices_, rows_, cols_;
+  std::string error_;
+};
+
+}  // namespace varia::plugins

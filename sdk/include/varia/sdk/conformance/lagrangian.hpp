@@ -1,0 +1,156 @@
+// The Lagrangian conformance suite: at random points (q, v), the gradient and Hessian a plugin
+// returns match central differences of its value and gradient; the Hessian is symmetric; every
+// evaluate() path gives the same value; a declared constant mass matrix is the Hessian's velocity
+// block; a declared symmetry leaves L invariant and its momentum map is equivariant.
+#pragma once
+
+#include <Eigen/Dense>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <sstream>
+#include <utility>
+
+#include "varia/core/lagrangian.hpp"
+#include "varia/sdk/conformance/failures.hpp"
+
+namespace varia::sdk::conformance {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+
+struct Evaluation {
+  double value;
+  VectorXd gradient;  // [dL/dq, dL/dv]
+  MatrixXd hessian;
+};
+
+// The Hessian dense, whether the plugin writes it dense or in its sparse pattern.
+inline Evaluation evaluate(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v) {
+  const int k = lagrangian.position_size() + lagrangian.velocity_size();
+  const int* rows = nullptr;
+  const int* cols = nullptr;
+  const int stored = lagrangian.hessian_pattern(&rows, &cols);
+  Evaluation e{0.0, VectorXd(k), MatrixXd::Zero(k, k)};
+  VectorXd entries(stored < 0 ? k * k : stored);
+  check(lagrangian.evaluate(q.data(), v.data(), &e.value, e.gradient.data(), entries.data()), "evaluate");
+  if (stored < 0) e.hessian = entries.reshaped(k, k);
+  for (int i = 0; i < stored; ++i) e.hessian(rows[i], cols[i]) = entries(i);
+  return e;
+}
+
+inline double value(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v) {
+  double l = 0;
+  check(lagrangian.evaluate(q.data(), v.data(), &l, nullptr, nullptr), "evaluate");
+  return l;
+}
+
+inline VectorXd gradient(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v) {
+  VectorXd g(lagrangian.position_size() + lagrangian.velocity_size());
+  check(lagrangian.evaluate(q.data(), v.data(), nullptr, g.data(), nullptr), "evaluate");
+  return g;
+}
+
+// Components of magnitude in [0.5, 1.5] with random signs: away from the origin (kepler).
+inline VectorXd random_point(int size, std::mt19937& engine) {
+  std::uniform_real_distribution<double> magnitude(0.5, 1.5);
+  VectorXd x(size);
+  for (int i = 0; i < size; ++i) x(i) = (engine() % 2 ? 1 : -1) * magnitude(engine);
+  return x;
+}
+
+// z = (q, v) with component i moved by `step`.
+inline std::pair<VectorXd, VectorXd> moved(const VectorXd& q, const VectorXd& v, int i, double step) {
+  VectorXd qs = q, vs = v;
+  (i < q.size() ? qs(i) : vs(i - q.size())) += step;
+  return {qs, vs};
+}
+
+// Largest deviations of the gradient from central differences of the value, and of the Hessian
+// from central differences of the gradient, relative to the derivatives' size.
+struct DerivativeErrors {
+  double gradient, hessian;
+};
+inline DerivativeErrors derivative_errors(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v) {
+  constexpr double step = 1e-5;
+  const Evaluation e = evaluate(lagrangian, q, v);
+  const int k = static_cast<int>(e.gradient.size());
+  VectorXd gradient_fd(k);
+  MatrixXd hessian_fd(k, k);
+  for (int i = 0; i < k; ++i) {
+    const auto [qp, vp] = moved(q, v, i, step);
+    const auto [qm, vm] = moved(q, v, i, -step);
+    gradient_fd(i) = (value(lagrangian, qp, vp) - value(lagrangian, qm, vm)) / (2 * step);
+    hessian_fd.col(i) = (gradient(lagrangian, qp, vp) - gradient(lagrangian, qm, vm)) / (2 * step);
+  }
+  const double g_scale = std::max(1.0, e.gradient.cwiseAbs().maxCoeff());
+  const double h_scale = std::max(1.0, e.hessian.cwiseAbs().maxCoeff());
+  return {(e.gradient - gradient_fd).cwiseAbs().maxCoeff() / g_scale,
+          (e.hessian - hessian_fd).cwiseAbs().maxCoeff() / h_scale};
+}
+
+// |a - b| relative to 1 + max(|a|, |b|) (as doctest's Approx).
+inline double gap(double a, double b) { return std::fabs(a - b) / (1 + std::max(std::fabs(a), std::fabs(b))); }
+
+// The symmetry claims at one point: L(g q, g v) = L(q, v) and |J(g q, g v)| = |J(q, v)|.
+inline void check_symmetry(Lagrangian& lagrangian, unsigned seed, const VectorXd& q, const VectorXd& v, double l,
+                           Failures& failures) {
+  const int m = lagrangian.position_size(), n = lagrangian.velocity_size();
+  VectorXd gq(m), gv(n), j(lagrangian.momentum_size()), gj(lagrangian.momentum_size());
+  check(lagrangian.act(seed, q.data(), v.data(), gq.data(), gv.data()), "act");
+  const double gl = value(lagrangian, gq, gv);
+  failures.expect(gap(gl, l) <= 1e-13, "L(g q, g v) = ", gl, " differs from L(q, v) = ", l);
+  check(lagrangian.momentum(q.data(), v.data(), j.data()), "momentum");
+  check(lagrangian.momentum(gq.data(), gv.data(), gj.data()), "momentum");
+  failures.expect(gap(gj.norm(), j.norm()) <= 1e-13, "|J(g q, g v)| = ", gj.norm(),
+                  " differs from |J(q, v)| = ", j.norm(), " (Ad*-equivariance)");
+}
+
+// The claims at one point (q, v).
+inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q, const VectorXd& v,
+                        Failures& failures) {
+  const int m = lagrangian.position_size(), n = lagrangian.velocity_size();
+  const Evaluation e = evaluate(lagrangian, q, v);
+  const auto [gradient_error, hessian_error] = derivative_errors(lagrangian, q, v);
+  failures.expect(gradient_error < 1e-8, "the gradient differs from central differences by ", gradient_error);
+  failures.expect(hessian_error < 1e-7, "the Hessian differs from central differences by ", hessian_error);
+  const double h_scale = std::max(1.0, e.hessian.cwiseAbs().maxCoeff());
+  failures.expect((e.hessian - e.hessian.transpose()).cwiseAbs().maxCoeff() <= 1e-14 * h_scale,
+                  "the Hessian is not symmetric");
+  const double l = value(lagrangian, q, v);
+  failures.expect(gap(l, e.value) <= 1e-15, "the value alone is ", l,
+                  ", with the derivatives ", e.value);
+  failures.expect((gradient(lagrangian, q, v) - e.gradient).cwiseAbs().maxCoeff() <=
+                      1e-15 * std::max(1.0, e.gradient.cwiseAbs().maxCoeff()),
+                  "the gradient alone differs from the gradient with the Hessian");
+  MatrixXd mass(n, n);
+  if (lagrangian.constant_mass_matrix(mass.data())) {
+    failures.expect((e.hessian.bottomRightCorner(n, n) - mass).cwiseAbs().maxCoeff() < 1e-13,
+                    "the declared constant mass matrix is not d2L/dv2");
+    failures.expect(e.hessian.bottomLeftCorner(n, m).cwiseAbs().maxCoeff() < 1e-13,
+                    "a constant mass matrix is declared but d2L/dv dq is not zero");
+  }
+  if (lagrangian.momentum_size() > 0) check_symmetry(lagrangian, seed, q, v, e.value, failures);
+}
+
+// The whole suite on one Lagrangian, at `trials` random points.
+inline Failures check_lagrangian(Lagrangian& lagrangian, std::mt19937& engine, int trials = 20) {
+  Failures failures;
+  for (int trial = 0; trial < trials && failures.empty(); ++trial) {
+    const VectorXd q = random_point(lagrangian.position_size(), engine);
+    const VectorXd v = random_point(lagrangian.velocity_size(), engine);
+    std::ostringstream where;
+    where << "at q = [" << q.transpose() << "], v = [" << v.transpose() << "]: ";
+    Failures at_point;
+    at_point.set_context(where.str());
+    try {
+      check_point(lagrangian, static_cast<unsigned>(trial), q, v, at_point);
+    } catch (const PluginFault& fault) {
+      at_point.expect(false, "a call failed: ", fault.what());
+    }
+    failures.append(at_point);
+  }
+  return failures;
+}
+
+}  // namespace varia::sdk::conformance

@@ -1,0 +1,61 @@
+// Loading one plugin file for the conformance suites (Boost.DLL), the way the host does: the ABI
+// version first, then the metadata, then objects made by its factory. An object holds a reference
+// to its library, so the library never unloads under a live object.
+#pragma once
+
+#include <boost/dll/shared_library.hpp>
+#include <filesystem>
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <stdexcept>
+#include <string>
+
+#include "varia/core/plugin_object.hpp"
+#include "varia/sdk/plugin.hpp"
+
+namespace varia::sdk::conformance {
+
+class LoadedPlugin {
+ public:
+  // Throws std::runtime_error naming the file when it is not a varia plugin of this ABI version.
+  explicit LoadedPlugin(const std::filesystem::path& file) : file_(file) {
+    library_ = std::make_shared<boost::dll::shared_library>();
+    boost::dll::fs::error_code ec;
+    library_->load(file, ec, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local);
+    if (ec) throw std::runtime_error(file.string() + ": cannot be loaded: " + ec.message());
+    if (!library_->has("varia_abi_version")) throw std::runtime_error(file.string() + ": no varia_abi_version");
+    const int abi = library_->get<const int>("varia_abi_version");
+    if (abi != kAbiVersion)
+      throw std::runtime_error(file.string() + ": ABI version " + std::to_string(abi) + ", expected " +
+                               std::to_string(kAbiVersion));
+    if (!library_->has("varia_info") || !library_->has("varia_create"))
+      throw std::runtime_error(file.string() + ": no varia_info or varia_create (use VARIA_PLUGIN)");
+    info_ = library_->get_alias<InfoFunction>("varia_info")();
+  }
+
+  const std::filesystem::path& file() const { return file_; }
+  const PluginInfo& info() const { return *info_; }
+  nlohmann::json parameter_schema() const { return nlohmann::json::parse(info_->parameter_schema); }
+
+  // An object of the plugin's kind T made from `parameters` in `context`; throws
+  // std::runtime_error with the plugin's message when it refuses them.
+  template <class T>
+  std::shared_ptr<T> create(const nlohmann::json& parameters,
+                            const nlohmann::json& context = {{"manifold", "Rn"}, {"point_size", 1}, {"dim", 1}}) const {
+    char error[512] = "";
+    auto& factory = library_->get_alias<CreateFunction>("varia_create");
+    PluginObject* object = factory(parameters.dump().c_str(), context.dump().c_str(), error, sizeof error);
+    if (object == nullptr) throw std::runtime_error(error);
+    // Made by the plugin, so typeid and dynamic_cast across the boundary are not to be trusted:
+    // the object is T because the plugin's kind says so.
+    auto library = library_;
+    return std::shared_ptr<T>(static_cast<T*>(object), [library](T* p) { delete p; });
+  }
+
+ private:
+  std::filesystem::path file_;
+  std::shared_ptr<boost::dll::shared_library> library_;
+  const PluginInfo* info_ = nullptr;
+};
+
+}  // namespace varia::sdk::conformance

@@ -1,0 +1,98 @@
+// The conformance suite of one plugin file, whatever its kind: its metadata (the parameter
+// schema and properties are JSON objects; the schema's defaults are the constructor's defaults),
+// then the suite of its kind over the objects it makes: every quadrature of its integer
+// parameters' sweep, every Lagrangian in each context it accepts with default parameters.
+// Kinds without a suite yet have their metadata checked only.
+#pragma once
+
+#include <memory>
+#include <nlohmann/json.hpp>
+#include <random>
+#include <string>
+#include <vector>
+
+#include "varia/sdk/conformance/failures.hpp"
+#include "varia/sdk/conformance/lagrangian.hpp"
+#include "varia/sdk/conformance/loader.hpp"
+#include "varia/sdk/conformance/quadrature.hpp"
+
+namespace varia::sdk::conformance {
+
+// The contexts a Lagrangian plugin may accept: Rn with dim 1, 2, 3, and SO3.
+inline std::vector<nlohmann::json> lagrangian_contexts() {
+  std::vector<nlohmann::json> contexts;
+  for (int n = 1; n <= 3; ++n) contexts.push_back({{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
+  contexts.push_back({{"manifold", "SO3"}, {"point_size", 9}, {"dim", 3}});
+  return contexts;
+}
+
+// The schema's "default" values, as a parameter object.
+inline nlohmann::json schema_defaults(const nlohmann::json& schema) {
+  nlohmann::json defaults = nlohmann::json::object();
+  const nlohmann::json properties = schema.value("properties", nlohmann::json::object());
+  for (const auto& [key, property] : properties.items())
+    if (property.is_object() && property.contains("default")) defaults[key] = property["default"];
+  return defaults;
+}
+
+inline void check_metadata(const LoadedPlugin& plugin, Failures& failures) {
+  const auto is_object = [](const char* text) {
+    return nlohmann::json::accept(text) && nlohmann::json::parse(text).is_object();
+  };
+  failures.expect(is_object(plugin.info().parameter_schema), "parameter_schema is not a JSON object");
+  failures.expect(is_object(plugin.info().properties), "properties is not a JSON object");
+}
+
+// Each Lagrangian made with {} in a context it accepts is checked, and agrees with the one made
+// from the schema's defaults.
+inline void check_lagrangian_plugin(const LoadedPlugin& plugin, Failures& failures) {
+  std::mt19937 engine(20240611);
+  const nlohmann::json defaults = schema_defaults(plugin.parameter_schema());
+  int accepted = 0;
+  for (const auto& context : lagrangian_contexts()) {
+    std::shared_ptr<Lagrangian> lagrangian;
+    try {
+      lagrangian = plugin.create<Lagrangian>(nlohmann::json::object(), context);
+    } catch (const std::runtime_error&) {
+      continue;  // not a context this plugin takes
+    }
+    ++accepted;
+    Failures in_context = check_lagrangian(*lagrangian, engine);
+    const auto explicit_ = plugin.create<Lagrangian>(defaults, context);
+    const VectorXd q = random_point(lagrangian->position_size(), engine);
+    const VectorXd v = random_point(lagrangian->velocity_size(), engine);
+    in_context.expect(value(*lagrangian, q, v) == value(*explicit_, q, v),
+                      "the schema's defaults are not the defaults of the constructor");
+    for (const auto& failure : in_context.list()) failures.expect(false, context.dump(), ": ", failure);
+  }
+  failures.expect(accepted > 0, "no context accepted with default parameters (Rn of dim 1-3, SO3)");
+}
+
+inline void check_quadrature_plugin(const LoadedPlugin& plugin, Failures& failures) {
+  for (const auto& parameters : parameter_sweep(plugin.parameter_schema()))
+    for (const auto& failure : check_quadrature(*plugin.create<Quadrature>(parameters)).list())
+      failures.expect(false, parameters.dump(), ": ", failure);
+}
+
+// The whole suite for one plugin file; what it checked is appended to `checked`.
+inline Failures check_plugin(const LoadedPlugin& plugin, std::string& checked) {
+  Failures failures;
+  check_metadata(plugin, failures);
+  if (!failures.empty()) return failures;
+  const std::string kind = plugin.info().kind;
+  checked = "metadata";
+  try {
+    if (kind == "quadrature") {
+      check_quadrature_plugin(plugin, failures);
+      checked += ", quadrature suite (exactness to the declared degree, nodes, weights, symmetry)";
+    } else if (kind == "lagrangian") {
+      check_lagrangian_plugin(plugin, failures);
+      checked += ", lagrangian suite (derivatives, Hessian symmetry, mass matrix, symmetry, defaults)";
+    }
+  } catch (const std::exception& e) {
+    failures.expect(false, "failed: ", e.what());
+  }
+  return failures;
+}
+
+}  // namespace varia::sdk::conformance

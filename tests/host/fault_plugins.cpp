@@ -1,0 +1,135 @@
+// Bad plugin files (spec: "Build layout", "Exit codes"): next to the bundled plugins, a directory
+// holds the fault plugins of tests/fault_plugins, a text file named .so and a foreign library.
+// `varia plugins` lists the good ones and refuses the bad with a reason; a scene that does not
+// need them runs; one that does exits 3 (4 for a non-finite value) naming the plugin file.
+// Plugins in files or directories that group or others can write are refused ("Trust").
+#include <doctest/doctest.h>
+
+#include <nlohmann/json.hpp>
+
+#include "host/support.hpp"
+#include "varia/core/plugin_object.hpp"
+
+namespace varia::test {
+namespace {
+
+using nlohmann::json;
+
+const fs::path kFaultPluginDir = VARIA_FAULT_PLUGIN_DIR;
+
+// A plugin directory (owner-only) holding every fault plugin, a text file and a foreign library.
+struct FaultDirectory {
+  TempDir dir;
+  FaultDirectory() {
+    for (const auto& file : files_in(kFaultPluginDir, ".so")) fs::copy_file(file, dir / file.filename().string());
+    write_file(dir / "not_a_library.so", "this is text, not a library\n");
+  }
+  std::string flag() const { return "--plugin-path '" + dir.path().string() + "'"; }
+};
+
+// The default scene with another Lagrangian, observing nothing (so that nothing evaluates the
+// Lagrangian before the first step).
+fs::path scene_with_lagrangian(const TempDir& dir, const std::string& type) {
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
+  scene["system"]["lagrangian"] = {{"type", type}};
+  scene.erase("observe");
+  const auto file = dir / (type + ".json");
+  write_file(file, scene.dump());
+  return file;
+}
+
+struct Refused {
+  const char* file;
+  std::string reason;
+};
+
+TEST_CASE("plugins lists the good fault plugins and refuses each bad file with its reason") {
+  const FaultDirectory faults;
+  const Refused refused[] = {
+      {"not_a_library.so", "not a shared library"},
+      {"fault_foreign.so", "not a varia plugin (no varia_abi_version symbol)"},
+      {"fault_wrong_abi.so", "ABI version " + std::to_string(kAbiVersion + 100) + ", this host speaks " +
+                                 std::to_string(kAbiVersion)},
+      {"fault_no_metadata.so", "missing metadata (no varia_info)"},
+  };
+  const auto table = run_varia("plugins " + faults.flag());
+  CAPTURE(table.out);
+  REQUIRE(table.code == 0);
+  for (const char* good : {"fault-construct", "fault-evaluate", "fault-nan", "pendulum"}) CHECK(contains(table.out, good));
+  const auto refusals = table.out.substr(table.out.find("\nrefused:\n"));
+  for (const auto& r : refused) {
+    CAPTURE(r.file);
+    CHECK(contains(refusals, (faults.dir / r.file).string() + ": " + r.reason));
+  }
+}
+
+struct SceneCase {
+  const char* lagrangian;
+  int code;
+  const char* file;    // the plugin file the one error line names ("" for exit 0)
+  const char* reason;  // and what went wrong
+};
+
+TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) naming the file; others run") {
+  const FaultDirectory faults;
+  const SceneCase cases[] = {
+      {"pendulum", 0, "", ""},
+      {"fault-construct", 3, "fault_throws_on_construction.so", "fault-construct: deliberate failure in the constructor"},
+      {"fault-evaluate", 3, "fault_throws_on_evaluation.so", "deliberate failure in evaluate"},
+      {"fault-nan", 4, "fault_returns_nan.so", "is not finite"},
+      {"fault-abi", 3, "fault_wrong_abi.so", "ABI version"},
+      {"fault-no-info", 3, "fault_no_metadata.so", "missing metadata (no varia_info)"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.lagrangian);
+    const auto scene = scene_with_lagrangian(faults.dir, c.lagrangian);
+    const auto outcome = run_varia("run '" + scene.string() + "' --quiet " + faults.flag());
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == c.code);
+    if (c.code == 0) {
+      CHECK(outcome.err.empty());
+      continue;
+    }
+    check_one_error_line(outcome, (faults.dir / c.file).string());
+    CHECK(contains(outcome.err, c.reason));
+  }
+}
+
+struct TrustCase {
+  const char* name;
+  fs::perms directory, file;
+  const char* reason;
+};
+
+TEST_CASE("plugins in files or directories writable by group or others are refused with the reason") {
+  using P = fs::perms;
+  const TrustCase cases[] = {
+      {"directory writable by others", P::owner_all | P::others_all, P::owner_all, "its directory"},
+      {"directory writable by group", P::owner_all | P::group_all, P::owner_all, "its directory"},
+      {"file writable by others", P::owner_all, P::owner_all | P::others_write, "mode 0702"},
+      {"file writable by group", P::owner_all, P::owner_all | P::group_write, "mode 0720"},
+  };
+  for (const auto& c : cases) {
+    CAPTURE(c.name);
+    TempDir dir, scenes;
+    const auto plugin = dir / "fault_returns_nan.so";
+    fs::copy_file(kFaultPluginDir / "fault_returns_nan.so", plugin);
+    fs::permissions(plugin, c.file);
+    fs::permissions(dir.path(), c.directory);
+    const std::string flag = " --plugin-path '" + dir.path().string() + "'";
+    const auto listing = run_varia("plugins" + flag);
+    CHECK(listing.code == 0);
+    CHECK(contains(listing.out, plugin.string() + ": not trusted: "));
+    CHECK(contains(listing.out, c.reason));
+    CHECK_FALSE(contains(listing.out, "fault-nan"));
+    // A scene that needs it: exit 3 naming the file and why; one that does not: it runs.
+    const auto needing = run_varia("run '" + scene_with_lagrangian(scenes, "fault-nan").string() + "' --quiet" + flag);
+    CHECK(needing.code == 3);
+    check_one_error_line(needing, plugin.string() + ": lagrangian type 'fault-nan' is in this file, which was refused: "
+                                                    "not trusted: ");
+    CHECK(run_varia("run scenes/default.json --quiet" + flag).code == 0);
+  }
+}
+
+}  // namespace
+}  // namespace varia::test

@@ -1,0 +1,193 @@
+// The effect plugins (core/effect.hpp): exact gradients and sparse Hessians against central
+// differences, for every effect plugin built; and the composite Lagrangian they make
+// (core/composite.hpp) integrated by the sparse Galerkin construction against an independent
+// reference: the elastic pendulum, whose acceleration is written here by hand and integrated by
+// Runge-Kutta-Fehlberg 7(8).
+#include <doctest/doctest.h>
+
+#include <Eigen/Core>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <map>
+#include <memory>
+
+#include "../core/fixtures.hpp"
+#include "load_plugin.hpp"
+#include "varia/core/composite.hpp"
+#include "varia/core/galerkin.hpp"
+#include "varia/core/mechanics.hpp"
+
+namespace {
+
+using Eigen::VectorXd;
+using Json = nlohmann::json;
+using varia::Effect;
+
+constexpr int kDim = 3;
+const double kMasses[] = {1.0, 2.0, 3.0};
+
+Json rn(int n) { return {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}}; }
+
+std::shared_ptr<Effect> make_effect(const std::string& type, const Json& parameters) {
+  auto effect = varia::test::load_plugin("effect", type).create<Effect>(parameters, rn(3 * kDim));
+  REQUIRE(effect->bind(kDim, 3, kMasses) == nullptr);
+  return effect;
+}
+
+struct Values {
+  double V = 0.0;
+  VectorXd gradient;
+  Eigen::MatrixXd hessian;  // dense, from the pattern
+};
+
+Values evaluate(Effect& effect, const VectorXd& x) {
+  const int *rows = nullptr, *cols = nullptr;
+  const int entries = effect.hessian_pattern(&rows, &cols);
+  Values values{0.0, VectorXd(x.size()), Eigen::MatrixXd::Zero(x.size(), x.size())};
+  VectorXd hessian(entries);
+  REQUIRE(effect.evaluate(x.data(), &values.V, values.gradient.data(), hessian.data()) == nullptr);
+  for (int e = 0; e < entries; ++e) values.hessian(rows[e], cols[e]) += hessian[e];
+  return values;
+}
+
+// Every effect's gradient and Hessian agree with central differences of V and of the gradient.
+void check_derivatives(Effect& effect) {
+  const int* indices = nullptr;
+  const int k = effect.coordinates(&indices);
+  VectorXd x(k);
+  for (int j = 0; j < k; ++j) x[j] = 0.3 + 0.7 * std::sin(1.7 * indices[j] + 0.4);
+  const Values at = evaluate(effect, x);
+  const double step = 1e-5;
+  for (int j = 0; j < k; ++j) {
+    VectorXd plus = x, minus = x;
+    plus[j] += step;
+    minus[j] -= step;
+    const Values a = evaluate(effect, plus), b = evaluate(effect, minus);
+    CHECK(at.gradient[j] == doctest::Approx((a.V - b.V) / (2 * step)).epsilon(1e-7));
+    const VectorXd column = (a.gradient - b.gradient) / (2 * step);
+    CHECK((at.hessian.col(j) - column).lpNorm<Eigen::Infinity>() <= 1e-6 * (1.0 + column.norm()));
+  }
+}
+
+const std::map<std::string, std::vector<Json>>& cases() {
+  static const std::map<std::string, std::vector<Json>> table{
+      {"gravity", {{{"g", {0.0, -9.81, 0.5}}}}},
+      {"spring",
+       {{{"between", {0, 2}}, {"stiffness", 3.0}, {"rest_length", 0.7}},
+        {{"anchor", {0.1, 0.2, 0.3}}, {"particle", 1}, {"stiffness", 2.0}, {"rest_length", 0.2}},
+        {{"between", {1, 0}}}}},
+      {"central", {{{"particle", 1}, {"mu", 2.0}, {"center", {0.5, -1.0, 0.2}}}, {{"particle", 2}}}}};
+  return table;
+}
+
+}  // namespace
+
+TEST_CASE("every effect plugin: its gradient and sparse Hessian are the exact derivatives of V") {
+  for (const auto& file : varia::test::plugin_files("effect")) {
+    const varia::test::LoadedPlugin plugin(file);
+    const std::string type = plugin.info().type;
+    CAPTURE(type);
+    REQUIRE(cases().count(type) == 1);
+    for (const Json& parameters : cases().at(type)) {
+      CAPTURE(parameters.dump());
+      check_derivatives(*make_effect(type, parameters));
+    }
+  }
+}
+
+TEST_CASE("effects touch only the coordinates they name, and refuse particles that do not exist") {
+  const int* indices = nullptr;
+  const auto between = make_effect("spring", {{"between", {0, 2}}});
+  CHECK(between->coordinates(&indices) == 2 * kDim);
+  CHECK(std::vector<int>(indices, indices + 6) == std::vector<int>{0, 1, 2, 6, 7, 8});
+  CHECK(make_effect("central", {{"particle", 1}})->coordinates(&indices) == kDim);
+  const int *rows = nullptr, *cols = nullptr;
+  CHECK(make_effect("gravity", {{"g", {0, 0, -1}}})->hessian_pattern(&rows, &cols) == 0);
+  auto spring = varia::test::load_plugin("effect", "spring").create<Effect>({{"between", {0, 5}}}, rn(9));
+  const varia::Status status = spring->bind(kDim, 3, kMasses);
+  REQUIRE(status != nullptr);
+  CHECK(std::string(status) == "between: particle 5 does not exist (the system has 3)");
+}
+
+namespace {
+
+// The elastic pendulum in the plane: m x'' = m g - k (1 - r/|x|) x (by hand, not from the plugins).
+constexpr double kStiffness = 10.0, kRest = 1.0, kGravity = 1.0;
+using State = std::array<double, 4>;
+
+State reference(const State& start, double T) {
+  namespace odeint = boost::numeric::odeint;
+  State x = start;
+  auto field = [](const State& s, State& ds, double) {
+    const double r = std::hypot(s[0], s[1]), f = -kStiffness * (1.0 - kRest / r);
+    ds = {s[2], s[3], f * s[0], f * s[1] - kGravity};
+  };
+  odeint::integrate_adaptive(odeint::make_controlled(1e-14, 1e-14, odeint::runge_kutta_fehlberg78<State>()), field,
+                             x, 0.0, T, 1e-3);
+  return x;
+}
+
+std::shared_ptr<varia::CompositeLagrangian> elastic_pendulum() {
+  std::vector<std::shared_ptr<Effect>> effects{
+      varia::test::load_plugin("effect", "gravity").create<Effect>({{"g", {0.0, -kGravity}}}, rn(2)),
+      varia::test::load_plugin("effect", "spring")
+          .create<Effect>({{"anchor", {0.0, 0.0}}, {"particle", 0}, {"stiffness", kStiffness}, {"rest_length", kRest}},
+                          rn(2))};
+  return std::make_shared<varia::CompositeLagrangian>(2, std::vector<double>{1.0}, std::move(effects));
+}
+
+// The Galerkin solution at T from start, step h (m = 1: p = v).
+VectorXd galerkin(int degree, varia::testing::FixedRule rule, const State& start, double h, double T,
+                  double* energy_drift = nullptr) {
+  varia::testing::FlatSpace space(2);
+  auto lagrangian = elastic_pendulum();
+  varia::GalerkinDiscreteLagrangian map(space, *lagrangian, rule, varia::equispaced_control_times(degree),
+                                        varia::SolverOptions{});
+  varia::LagrangianEvaluator evaluator(*lagrangian);
+  VectorXd q(2), p(2);
+  q << start[0], start[1];
+  p << start[2], start[3];
+  const double e0 = evaluator.energy(q.data(), p.data());
+  double drift = 0.0;
+  for (long k = 0; k < std::lround(T / h); ++k) {
+    map.step(q.data(), p.data(), h, q.data(), p.data());
+    drift = std::max(drift, std::abs(evaluator.energy(q.data(), p.data()) - e0));
+  }
+  if (energy_drift != nullptr) *energy_drift = drift;
+  VectorXd result(4);
+  result << q, p;
+  return result;
+}
+
+const State kStart{0.8, -0.9, 0.0, 0.3};
+
+}  // namespace
+
+TEST_CASE("the composite elastic pendulum (sparse Galerkin) converges to an independent reference at the "
+          "construction's order: 2 for degree 1 (trapezoid), 4 for degree 2 (Lobatto)") {
+  const double T = 5.0;
+  const State x = reference(kStart, T);
+  const VectorXd exact = Eigen::Map<const VectorXd>(x.data(), 4);
+  struct Case {
+    int degree;
+    varia::testing::FixedRule rule;
+    double order;
+  };
+  for (const Case& c : {Case{1, varia::testing::trapezoid(), 2.0}, Case{2, varia::testing::lobatto3(), 4.0}}) {
+    const double e1 = (galerkin(c.degree, c.rule, kStart, 0.02, T) - exact).norm();
+    const double e2 = (galerkin(c.degree, c.rule, kStart, 0.01, T) - exact).norm();
+    MESSAGE("degree " << c.degree << ": errors " << e1 << ", " << e2 << ", order " << std::log2(e1 / e2));
+    CHECK(std::log2(e1 / e2) == doctest::Approx(c.order).epsilon(0.05));
+  }
+}
+
+TEST_SUITE("long") {
+  TEST_CASE("the composite elastic pendulum's energy stays bounded without drift over 10^5 steps") {
+    double early = 0.0, whole = 0.0;
+    galerkin(1, varia::testing::trapezoid(), kStart, 0.01, 100.0, &early);
+    galerkin(1, varia::testing::trapezoid(), kStart, 0.01, 1000.0, &whole);
+    MESSAGE("energy error max: over 10^4 steps " << early << ", over 10^5 steps " << whole);
+    CHECK(whole < 1e-2);
+    CHECK(whole < 1.5 * early);
+  }
+}
