@@ -71,6 +71,13 @@ Predictions predict(const Composition& c) {
     else if (c.construction == Construction::one_step && c.method_symplectic && c.method_equivariant)
       p.momentum_conserved = true;
   }
+  // Forces (discrete Lagrange-d'Alembert) keep the order but none of the conservation theorems.
+  if (c.forced) {
+    p.symplectic.reset();
+    p.energy_bounded.reset();
+    p.momentum_conserved.reset();
+    p.reason += "; with forces the conservation theorems do not apply";
+  }
   return p;
 }
 

@@ -110,6 +110,7 @@ const std::map<std::string, Construction>& constructions() {
 // the galerkin construction implements (core/galerkin.hpp).
 void create_forces(const Scene& scene, Registry& registry, Assembly& a) {
   if (scene.forces.empty()) return;
+  a.composition.forced = true;
   if (scene.construction != "galerkin")
     throw InputError(fmt::format("/system/forces: forces are taken by construction 'galerkin' only, not '{}'",
                                  scene.construction));

@@ -95,7 +95,7 @@ struct CommandCase {
   const char* output;  // expected in stdout (code 0) or in the one stderr line
 };
 
-TEST_CASE("command line: help and version exit 0, bad flags and unfinished commands exit 2") {
+TEST_CASE("command line: help and version exit 0, bad flags and bad arguments exit 2") {
   const CommandCase cases[] = {
       {"--help", 0, "Subcommands:"},
       {"run --help", 0, "--summary"},
@@ -106,7 +106,6 @@ TEST_CASE("command line: help and version exit 0, bad flags and unfinished comma
       {"run scenes/default.json --bogus", 2, "--bogus"},
       {"frobnicate", 2, "unknown command 'frobnicate'; the commands are: plugins, run"},
       {"run no/such/scene.json", 2, "no/such/scene.json: cannot be read"},
-      {"cost scenes/default.json", 2, "not available yet"},
       {"ld scenes/default.json --q0 1.3,2 --q1 1.2 --h 0.1", 2, "--q0: expected 1 comma-separated"},
       {"ld scenes/default.json --q0 1.3 --q1 abc --h 0.1", 2, "--q1: expected 1"},
       {"ld scenes/default.json --q0 1.3 --q1 1.2 --h -1", 2, "--h: expected a number > 0"},

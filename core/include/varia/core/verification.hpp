@@ -27,6 +27,7 @@ struct Composition {
   bool method_symplectic = false;      // declared by one-step plugins
   bool method_equivariant = false;     // under the Lagrangian's symmetry
   bool lagrangian_invariant = false;   // the Lagrangian declares a symmetry group
+  bool forced = false;                 // non-conservative forces (Lagrange-d'Alembert principle)
 };
 
 struct Predictions {
