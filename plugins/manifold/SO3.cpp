@@ -9,6 +9,7 @@
 
 #include "varia/core/manifold.hpp"
 #include "varia/core/so3.hpp"
+#include "varia/sdk/no_parameters.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace {
@@ -22,12 +23,7 @@ constexpr double kMembershipTolerance = 1e-9;
 class SO3 final : public varia::Manifold {
  public:
   static constexpr const char* version = "1.0.0";
-  static constexpr const char* parameter_schema = R"({
-    "$schema": "http://json-schema.org/draft-07/schema#",
-    "type": "object",
-    "properties": {},
-    "additionalProperties": false
-  })";
+  static constexpr const char* parameter_schema = varia::sdk::kNoParameters;
   static constexpr const char* properties = R"json({
     "group": "SO(3) (left multiplication)",
     "chart": "natural: R0 exp(xi), exp by Rodrigues' formula",
@@ -36,8 +32,7 @@ class SO3 final : public varia::Manifold {
   })json";
 
   SO3(const nlohmann::json& parameters, const varia::sdk::Context&) {
-    if (!parameters.empty())
-      throw std::invalid_argument("SO3 takes no parameters, got " + parameters.dump());
+    varia::sdk::require_no_parameters(parameters, "SO3");
   }
 
   int point_size() const noexcept override { return 9; }

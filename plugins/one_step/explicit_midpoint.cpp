@@ -1,5 +1,5 @@
 // The explicit midpoint rule y1 = y0 + h f(y0 + h/2 f(y0)): explicit, order 2, not self-adjoint.
-#include "support.hpp"
+#include "varia/sdk/no_parameters.hpp"
 #include "varia/sdk/runge_kutta.hpp"
 
 namespace {
@@ -7,7 +7,7 @@ namespace {
 class ExplicitMidpoint final : public varia::sdk::RungeKutta {
  public:
   static constexpr const char* version = "1.0.0";
-  static constexpr const char* parameter_schema = varia::plugins::kNoParameters;
+  static constexpr const char* parameter_schema = varia::sdk::kNoParameters;
   static constexpr const char* properties = R"({
     "order": 2,
     "self_adjoint": false,
@@ -18,7 +18,7 @@ class ExplicitMidpoint final : public varia::sdk::RungeKutta {
 
   ExplicitMidpoint(const nlohmann::json& parameters, const varia::sdk::Context&)
       : RungeKutta(varia::sdk::explicit_midpoint(), 2, false) {
-    varia::plugins::require_no_parameters(parameters, "explicit-midpoint");
+    varia::sdk::require_no_parameters(parameters, "explicit-midpoint");
   }
 };
 

@@ -1,7 +1,7 @@
 // The classical fourth-order Runge-Kutta method: explicit, order 4, not self-adjoint. With
 // Simpson's rule it gives the paper's SVIRK4 / sviRK4Sim, with the Euler-Maclaurin formula
 // sviRK4EM (sec. 3 "Examples").
-#include "support.hpp"
+#include "varia/sdk/no_parameters.hpp"
 #include "varia/sdk/runge_kutta.hpp"
 
 namespace {
@@ -9,7 +9,7 @@ namespace {
 class Rk4 final : public varia::sdk::RungeKutta {
  public:
   static constexpr const char* version = "1.0.0";
-  static constexpr const char* parameter_schema = varia::plugins::kNoParameters;
+  static constexpr const char* parameter_schema = varia::sdk::kNoParameters;
   static constexpr const char* properties = R"({
     "order": 4,
     "self_adjoint": false,
@@ -20,7 +20,7 @@ class Rk4 final : public varia::sdk::RungeKutta {
 
   Rk4(const nlohmann::json& parameters, const varia::sdk::Context&)
       : RungeKutta(varia::sdk::classic_rk4(), 4, false) {
-    varia::plugins::require_no_parameters(parameters, "rk4");
+    varia::sdk::require_no_parameters(parameters, "rk4");
   }
 };
 

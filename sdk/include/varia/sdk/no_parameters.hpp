@@ -1,12 +1,12 @@
-// What the Runge-Kutta one_step plugins share: the parameter schema of a method without
-// parameters, and the check that none were given.
+// For plugins that take no parameters: their parameter schema, and the check that none were given
+// (the host checks the schema already; this keeps a plugin made directly just as safe).
 #pragma once
 
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
 
-namespace varia::plugins {
+namespace varia::sdk {
 
 inline constexpr const char* kNoParameters = R"({
     "$schema": "http://json-schema.org/draft-07/schema#",
@@ -17,8 +17,7 @@ inline constexpr const char* kNoParameters = R"({
 
 inline void require_no_parameters(const nlohmann::json& parameters, const char* type) {
   if (!parameters.empty())
-    throw std::invalid_argument(std::string(type) + " takes no parameters, got " +
-                                parameters.dump());
+    throw std::invalid_argument(std::string(type) + " takes no parameters, got " + parameters.dump());
 }
 
-}  // namespace varia::plugins
+}  // namespace varia::sdk
