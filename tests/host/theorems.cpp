@@ -59,13 +59,16 @@ TEST_CASE("galerkin degree s with s+1 Lobatto or s Gauss points has order 2s, ag
         CAPTURE(rule);
         CAPTURE((*system)["type"]);
         Verified v(scene_of(*system, galerkin(s, rule, points), 1.0, 0.2));
-        for (const char* name : {"global_order", "ld_order"}) {
-          CAPTURE(name);
-          CAPTURE(v[name].note);
-          REQUIRE(v[name].measured);
-          CHECK(*v[name].measured == doctest::Approx(2 * s).epsilon(0.1));
-          CHECK(v[name].holds == true);
-        }
+        CAPTURE(v["global_order"].note);
+        REQUIRE(v["global_order"].measured);
+        CHECK(*v["global_order"].measured == doctest::Approx(2 * s).epsilon(0.1));
+        CHECK(v["global_order"].holds == true);
+        // The theorem bounds the order of L_d from below; a linear system may do better, and at
+        // s = 3 the error reaches round-off within three halvings, leaving a short fit (see note).
+        CAPTURE(v["ld_order"].note);
+        REQUIRE(v["ld_order"].measured);
+        CHECK(*v["ld_order"].measured >= 2 * s - 0.3);
+        CHECK(v["ld_order"].holds == true);
         CHECK(v["self_adjoint"].holds == true);
         CHECK(v["symplectic"].holds == true);
         CHECK(v["energy_bounded"].holds == true);
@@ -137,4 +140,21 @@ TEST_CASE("explicit midpoint run directly is reported neither symplectic nor sel
   CHECK(v["symplectic"].holds == false);
   CHECK(v["self_adjoint"].holds == false);
   for (const auto& c : v.checks) CHECK_FALSE(c.failed());
+}
+
+TEST_CASE("verify exits 1 naming the properties a plugin falsely declares (Euler claiming order 2, self-adjoint)") {
+  varia::test::TempDir dir;
+  const json document = scene_of({{"type", "pendulum"}},
+                                 {{"construction", "shooting"},
+                                  {"quadrature", {{"type", "trapezoid"}}},
+                                  {"one_step", {{"type", "lying-euler"}}}},
+                                 1.0, 0.1);
+  varia::test::write_file(dir / "liar.json", document.dump());
+  const auto outcome = varia::test::run_varia("verify '" + (dir / "liar.json").string() + "' --plugin-path '" +
+                                              std::string(VARIA_FAULT_PLUGIN_DIR) + "'");
+  CAPTURE(outcome.out);
+  CAPTURE(outcome.err);
+  CHECK(outcome.code == 1);
+  for (const char* property : {"self_adjoint", "ld_order", "global_order"})
+    CHECK(varia::test::contains(outcome.err, property));
 }
