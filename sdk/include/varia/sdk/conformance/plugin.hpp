@@ -18,10 +18,10 @@
 
 namespace varia::sdk::conformance {
 
-// The contexts a Lagrangian plugin may accept: Rn with dim 1, 2, 3, and SO3.
+// The contexts a Lagrangian plugin may accept: Rn with dim 1 to 8, and SO3.
 inline std::vector<nlohmann::json> lagrangian_contexts() {
   std::vector<nlohmann::json> contexts;
-  for (int n = 1; n <= 3; ++n) contexts.push_back({{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
+  for (int n = 1; n <= 8; ++n) contexts.push_back({{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
   contexts.push_back({{"manifold", "SO3"}, {"point_size", 9}, {"dim", 3}});
   return contexts;
 }
@@ -65,7 +65,7 @@ inline void check_lagrangian_plugin(const LoadedPlugin& plugin, Failures& failur
                       "the schema's defaults are not the defaults of the constructor");
     for (const auto& failure : in_context.list()) failures.expect(false, context.dump(), ": ", failure);
   }
-  failures.expect(accepted > 0, "no context accepted with default parameters (Rn of dim 1-3, SO3)");
+  failures.expect(accepted > 0, "no context accepted with default parameters (Rn of dim 1 to 8, SO3)");
 }
 
 inline void check_quadrature_plugin(const LoadedPlugin& plugin, Failures& failures) {
