@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -159,7 +160,11 @@ class Stepper {
         progress.update(state_.step);
       }
     } catch (const NumericalFailure& e) {
-      failure = Failure{state_.step + 1, state_.t, e.residual(), e.what()};
+      // A non-finite observable is found after its step completed: that step failed, from the
+      // time it started at.
+      failure = observable_failed_
+                    ? Failure{state_.step, std::max(0L, state_.step - 1) * scene_.step, e.residual(), e.what()}
+                    : Failure{state_.step + 1, state_.t, e.residual(), e.what()};
     }
     state_.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (csv_) csv_->flush();
@@ -189,6 +194,15 @@ class Stepper {
   // Spec "output.every": every k-th step; step 0 and the last step are always written.
   void observe_and_write() {
     observer_.observe(state_.q.data(), state_.p.data());
+    // Never a non-finite number in the trajectory: an observable that overflows (energy of a
+    // finite but huge state) ends the run like a non-finite state does.
+    const auto& values = observer_.values();
+    for (std::size_t i = 0; i < values.size(); ++i)
+      if (!std::isfinite(values[i])) {
+        observable_failed_ = true;
+        throw NumericalFailure(fmt::format("a non-finite {} ({})", observer_.columns()[i], values[i]),
+                               std::nan(""));
+      }
     const bool due = state_.step % scene_.output_every == 0 || state_.step == scene_.steps;
     if (csv_ && due)
       csv_->row(state_.t, state_.q.data(), static_cast<int>(state_.q.size()), state_.p.data(),
@@ -202,6 +216,7 @@ class Stepper {
   Trajectory state_;
   std::unique_ptr<CsvWriter> csv_;
   std::unique_ptr<PlotRecorder> plot_;
+  bool observable_failed_ = false;
 };
 
 }  // namespace
