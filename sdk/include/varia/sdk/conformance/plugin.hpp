@@ -69,9 +69,10 @@ inline void check_lagrangian_plugin(const LoadedPlugin& plugin, Failures& failur
 }
 
 inline void check_quadrature_plugin(const LoadedPlugin& plugin, Failures& failures) {
-  for (const auto& parameters : parameter_sweep(plugin.parameter_schema()))
-    for (const auto& failure : check_quadrature(*plugin.create<Quadrature>(parameters)).list())
-      failures.expect(false, parameters.dump(), ": ", failure);
+  for (const auto& parameters : parameter_sweep(plugin.parameter_schema())) {
+    const Failures found = check_quadrature(*plugin.create<Quadrature>(parameters));  // kept alive for list()
+    for (const auto& failure : found.list()) failures.expect(false, parameters.dump(), ": ", failure);
+  }
 }
 
 // The whole suite for one plugin file; what it checked is appended to `checked`.
