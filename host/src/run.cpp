@@ -96,6 +96,12 @@ json run_record(const Scene& scene, const Assembly& a, const Observer& observer,
 void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, const Observer& observer,
                          const Trajectory& state) {
   const auto& statistics = a.map->solver_statistics();
+  std::string method = scene.construction;
+  if (scene.construction == "galerkin") method += fmt::format(" degree {}", scene.degree);
+  if (scene.one_step) method += " with " + scene.one_step->type;
+  if (scene.quadrature) method += ", quadrature " + scene.quadrature->type + " " + scene.quadrature->parameters.dump();
+  fmt::print(to, "system            {} on {}\n", scene.lagrangian.type, scene.manifold.type);
+  fmt::print(to, "method            {}, h = {}\n", method, scene.step);
   fmt::print(to, "steps             {}\n", state.step);
   fmt::print(to, "final time        {:.10g}\n", state.t);
   if (scene.observe.energy) fmt::print(to, "energy error max  {:.3e}\n", observer.energy_error());
