@@ -77,7 +77,7 @@ Row measure(Method& m, double h, long steps) {
   Assembly& a = m.assembly;
   const long evaluations = evaluation_count(a.map->evaluations());
   const long iterations = a.map->solver_statistics().iterations;
-  Observer observer(Observe{true, false, false}, *a.lagrangian, a.v0, m.scene.solver);
+  Observer observer(Observe{true, false, false}, *a.manifold, *a.lagrangian, a.v0, m.scene.solver);
   const TimedRun f = run_timed(a, h, steps, &observer);
   Row row{h, steps, distance(f, *m.truth), observer.energy_error(), f.seconds,
           a.map->solver_statistics().iterations - iterations, evaluation_count(a.map->evaluations()) - evaluations};

@@ -7,17 +7,9 @@
 
 namespace varia::host {
 
-namespace {
-// ||I - R^T R|| (Frobenius) for a row-major rotation matrix R (spec: "orthogonality").
-double orthogonality_defect(const double* q) {
-  const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> R(q);
-  return (Eigen::Matrix3d::Identity() - R.transpose() * R).norm();
-}
-}  // namespace
-
-Observer::Observer(const Observe& observe, Lagrangian& lagrangian, const Eigen::VectorXd& v0,
-                   const SolverOptions& options)
-    : what_(observe), lagrangian_(lagrangian), evaluator_(lagrangian), options_(options), v_(v0) {
+Observer::Observer(const Observe& observe, const Manifold& manifold, Lagrangian& lagrangian,
+                   const Eigen::VectorXd& v0, const SolverOptions& options)
+    : what_(observe), manifold_(manifold), lagrangian_(lagrangian), evaluator_(lagrangian), options_(options), v_(v0) {
   if (what_.momentum) momentum_size_ = lagrangian.momentum_size();
 }
 
@@ -38,7 +30,7 @@ void Observer::observe(const double* q, const double* p) {
     values_.resize(values_.size() + momentum_size_);
     check(lagrangian_.momentum(q, v_.data(), values_.data() + values_.size() - momentum_size_), "momentum");
   }
-  if (what_.orthogonality) values_.push_back(orthogonality_defect(q));
+  if (what_.orthogonality) values_.push_back(manifold_.constraint_error(q));  // ||I - R^T R||_F on SO3
   update_errors();
 }
 

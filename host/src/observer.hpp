@@ -9,6 +9,7 @@
 
 #include "scene.hpp"
 #include "varia/core/lagrangian.hpp"
+#include "varia/core/manifold.hpp"
 #include "varia/core/mechanics.hpp"
 
 namespace varia::host {
@@ -16,7 +17,7 @@ namespace varia::host {
 class Observer {
  public:
   // v0 is the initial velocity, the first warm start of the inverse Legendre transform.
-  Observer(const Observe& observe, Lagrangian& lagrangian, const Eigen::VectorXd& v0,
+  Observer(const Observe& observe, const Manifold& manifold, Lagrangian& lagrangian, const Eigen::VectorXd& v0,
            const SolverOptions& options);
   std::vector<std::string> columns() const;  // energy; momentum0..; orthogonality
   // Computes the observables at (q, p) into values() and updates the largest deviations from the
@@ -30,6 +31,7 @@ class Observer {
  private:
   void update_errors();
   Observe what_;
+  const Manifold& manifold_;  // its constraint_error is the orthogonality observable
   Lagrangian& lagrangian_;
   LagrangianEvaluator evaluator_;  // its own counters: observing does not count as the method's work
   SolverOptions options_;

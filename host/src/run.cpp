@@ -143,7 +143,7 @@ class PlotRecorder {
 class Stepper {
  public:
   Stepper(const Scene& scene, Assembly& a, const RunOptions& options)
-      : scene_(scene), a_(a), observer_(scene.observe, *a.lagrangian, a.v0, scene.solver) {
+      : scene_(scene), a_(a), observer_(scene.observe, *a.manifold, *a.lagrangian, a.v0, scene.solver) {
     state_.q = a.q0;
     state_.p = a.p0;
     state_.q1.resize(a.q0.size());
