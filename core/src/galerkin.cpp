@@ -33,8 +33,6 @@ void check_control_times(const std::vector<double>& d) {
     if (!(d[i] > d[i - 1])) throw std::invalid_argument("control times must increase");
 }
 
-bool small(double value, double tolerance, double scale) { return value <= tolerance * (1.0 + scale); }
-
 }  // namespace
 
 std::vector<double> equispaced_control_times(int degree) {
@@ -335,7 +333,7 @@ void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_e
     residuals_.push_back(norm);
     if (!std::isfinite(norm))
       throw NumericalFailure("the Galerkin equations have a non-finite residual", norm);
-    if (small(norm, options_.tolerance, scale)) return statistics_.record(iteration);
+    if (options_.converged(norm, scale)) return statistics_.record(iteration);
     if (iteration == options_.max_iterations)
       throw NumericalFailure("Newton's method did not converge in " +
                                  std::to_string(options_.max_iterations) + " iterations",
@@ -345,8 +343,7 @@ void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_e
     else
       solve_dense(first_unknown, first_equation, blocks);
     points_.middleCols(first_unknown, blocks).reshaped() -= update;
-    if (small(update.lpNorm<Eigen::Infinity>(), options_.tolerance,
-              points_.lpNorm<Eigen::Infinity>())) {
+    if (options_.converged(update.lpNorm<Eigen::Infinity>(), points_.lpNorm<Eigen::Infinity>())) {
       action(h, Order::gradient, forced);
       return statistics_.record(iteration + 1);
     }

@@ -96,11 +96,9 @@ void LagrangianEvaluator::inverse_legendre(const double* q, const double* p, dou
   for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
     velocity_newton_update(q, v, p);
     residual_norm = residual_.lpNorm<Eigen::Infinity>();
-    if (residual_norm <= options.tolerance * (1.0 + momentum.lpNorm<Eigen::Infinity>())) return;
+    if (options.converged(residual_norm, momentum.lpNorm<Eigen::Infinity>())) return;
     velocity -= update_;
-    if (update_.lpNorm<Eigen::Infinity>() <=
-        options.tolerance * (1.0 + velocity.lpNorm<Eigen::Infinity>()))
-      return;
+    if (options.converged(update_.lpNorm<Eigen::Infinity>(), velocity.lpNorm<Eigen::Infinity>())) return;
   }
   throw NumericalFailure("the inverse Legendre transform did not converge", residual_norm);
 }

@@ -7,8 +7,6 @@ namespace varia {
 
 namespace {
 
-bool small(double value, double tolerance, double scale) { return value <= tolerance * (1.0 + scale); }
-
 PhaseSpace phase_space(ShootingForm form) {
   return form == ShootingForm::lagrangian ? PhaseSpace::tangent : PhaseSpace::cotangent;
 }
@@ -188,7 +186,7 @@ void ShootingDiscreteLagrangian::solve(const double* q0, double h, Target target
     residuals_.push_back(norm);
     if (!std::isfinite(norm))
       throw NumericalFailure("the shooting equations have a non-finite residual", norm);
-    if (settled || small(norm, options_.tolerance, scale)) return statistics_.record(iteration);
+    if (settled || options_.converged(norm, scale)) return statistics_.record(iteration);
     if (iteration == options_.max_iterations)
       throw NumericalFailure("the shooting Newton iteration did not converge in " +
                                  std::to_string(options_.max_iterations) + " iterations",
@@ -196,8 +194,7 @@ void ShootingDiscreteLagrangian::solve(const double* q0, double h, Target target
     jacobian_lu_.compute(jacobian_);
     update_.noalias() = jacobian_lu_.solve(residual_);
     w_ -= update_;
-    settled = small(update_.lpNorm<Eigen::Infinity>(), options_.tolerance,
-                    w_.lpNorm<Eigen::Infinity>());
+    settled = options_.converged(update_.lpNorm<Eigen::Infinity>(), w_.lpNorm<Eigen::Infinity>());
   }
 }
 

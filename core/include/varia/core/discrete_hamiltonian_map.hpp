@@ -12,6 +12,8 @@ namespace varia {
 struct SolverOptions {
   double tolerance = 1e-14;  // on the scaled residual or the scaled Newton update
   int max_iterations = 50;
+  // The convergence test of every solve: |value| <= tolerance (1 + |scale|).
+  bool converged(double value, double scale) const { return value <= tolerance * (1.0 + scale); }
 };
 
 // Plugin evaluations made so far (the run record's "evaluations").
