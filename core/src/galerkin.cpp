@@ -5,6 +5,8 @@
 #include <stdexcept>
 #include <string>
 
+#include "varia/core/compensated.hpp"
+
 namespace varia {
 
 namespace {
@@ -84,8 +86,15 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
         "the Galerkin construction takes quadratures without endpoint derivative terms");
   extrapolation_.resize(s_ + 1, s_ + 1);
   for (int nu = 0; nu <= s_; ++nu) extrapolation_.col(nu) = basis_.at(1.0 + control_times[nu]);
+  origin_.resize(n_);
   points_.resize(n_, s_ + 1);
   previous_.resize(n_, s_ + 1);
+  previous_end_.resize(n_);
+  carry_q_ = Eigen::VectorXd::Zero(n_);
+  carry_p_ = Eigen::VectorXd::Zero(n_);
+  end_p_.resize(n_);
+  impulse_.resize(n_);
+  change_.resize((s_ + 1) * n_);
   q_.resize(n_);
   v_.resize(n_);
   velocity_ = Eigen::VectorXd::Zero(n_);
@@ -104,6 +113,7 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
     }
   } else {
     hess_.resize(2 * n_, 2 * n_);
+    column_.resize(2 * n_);
     hessian_.resize((s_ + 1) * n_, (s_ + 1) * n_);
     jacobian_.resize(s_ * n_, s_ * n_);
     lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(s_ * n_);
@@ -111,7 +121,15 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   // The forces' Jacobian [df/dq, df/dv]: rows are equations (weighted by l_nu, never by v).
   for (std::size_t e = 0; e < forces_.rows().size(); ++e)
     entries_.push_back(Entry{forces_.rows()[e], forces_.cols()[e] % n_, false, forces_.cols()[e] >= n_});
-  explicit_ = explicit_form_applies(quadrature);
+  if (explicit_form_applies(quadrature)) {
+    switch (n_) {
+      case 1: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<1>; break;
+      case 2: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<2>; break;
+      case 3: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<3>; break;
+      case 4: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<4>; break;
+      default: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<Eigen::Dynamic>;
+    }
+  }
 }
 
 const EvaluationCounters& GalerkinDiscreteLagrangian::evaluations() const {
@@ -136,8 +154,10 @@ bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
     else
       return false;
   }
-  mass_.compute(mass_matrix_);
-  if (mass_.info() != Eigen::Success) return false;
+  // M symmetric positive definite (the Lagrangian hyperregular); M^{-1} is formed once.
+  const Eigen::LLT<Eigen::MatrixXd> mass(mass_matrix_);
+  if (mass.info() != Eigen::Success) return false;
+  inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
   force_.resize(n_);
   last_q_.resize(n_);
   return true;
@@ -145,29 +165,41 @@ bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
 
 // L_d = h (b0 L(q0, v) + b1 L(q1, v)), v = (q1 - q0)/h, L = v.Mv/2 - V(q), b0 + b1 = 1:
 //   p0 = -D1 L_d = M v - h b0 dL/dq(q0)  =>  v = M^{-1} (p0 + h b0 dL/dq(q0)), q1 = q0 + h v,
-//   p1 =  D2 L_d = M v + h b1 dL/dq(q1).
+//   p1 =  D2 L_d = M v + h b1 dL/dq(q1)
+// (paper, sec. 2: degree 1 with the trapezoidal rule is Stormer-Verlet). N is n, or Dynamic:
+// the workspace is the class's dynamic vectors seen through fixed-size maps, so a step makes one
+// plugin call and no dynamic-size arithmetic for n <= 4.
+template <int N>
 void GalerkinDiscreteLagrangian::explicit_step(const double* q0, const double* p0, double h,
                                                double* q1, double* p1) {
-  const Eigen::Map<const Eigen::VectorXd> start(q0, n_), momentum(p0, n_);
-  if (!has_force_ || last_q_ != start) {
+  using Vector = Eigen::Matrix<double, N, 1>;
+  using Matrix = Eigen::Matrix<double, N, N>;
+  const Eigen::Map<const Vector> start(q0, n_), momentum(p0, n_);
+  const Eigen::Map<const Matrix> mass(mass_matrix_.data(), n_, n_), inverse(inverse_mass_.data(), n_, n_);
+  const Eigen::Map<const Vector> dLdq(grad_.data(), n_);  // the head of [dL/dq, dL/dv]
+  Eigen::Map<Vector> force(force_.data(), n_), last(last_q_.data(), n_), kick(q_.data(), n_),
+      velocity(v_.data(), n_);
+  if (!has_force_ || last != start) {
     lagrangian_.gradient(q0, v_.data(), grad_.data());  // dL/dq does not depend on v here
-    force_ = grad_.head(n_);
+    force = dLdq;
   }
-  v_ = momentum + h * b0_ * force_;
-  mass_.solveInPlace(v_);
-  Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);
-  end = start + h * v_;
+  kick = momentum + (h * b0_) * force;
+  velocity.noalias() = inverse * kick;
+  Eigen::Map<Vector> end(q1, n_), momentum1(p1, n_);
+  end = start + h * velocity;
   lagrangian_.gradient(q1, v_.data(), grad_.data());
-  force_ = grad_.head(n_);
-  last_q_ = end;
+  force = dLdq;
+  last = end;
   has_force_ = true;
-  momentum1.noalias() = mass_matrix_ * v_;
-  momentum1 += h * b1_ * force_;
+  momentum1.noalias() = mass * velocity;
+  momentum1 += (h * b1_) * force;
   statistics_.record(0);
 }
 
+// q_i = q^0 + sum_nu l_nu(c_i) (q^nu - q^0) (sum_nu l_nu = 1), v_i = (1/h) sum_nu l'_nu(c_i) (q^nu - q^0).
 void GalerkinDiscreteLagrangian::interpolate(int i, double h) {
-  q_.noalias() = points_ * basis_.phi.row(i).transpose();
+  q_ = origin_;
+  q_.noalias() += points_ * basis_.phi.row(i).transpose();
   v_.noalias() = points_ * basis_.dphi.row(i).transpose();
   v_ /= h;
 }
@@ -181,11 +213,16 @@ double GalerkinDiscreteLagrangian::weight(int i, int nu, bool by_v, double h) co
 //   dS/dq^nu = sum_i b_i (h l_nu L_q + l'_nu L_v),
 //   d2S/dq^nu dq^mu = sum_i b_i (h l_nu l_mu L_qq + l_nu l'_mu L_qv + l'_nu l_mu L_vq
 //                                + l'_nu l'_mu L_vv / h).
+// With the gradient, impulse_ = h sum_i b_i (L_q + f)(c_i) = sum_nu (dS/dq^nu + f_d^nu), since
+// sum_nu l_nu = 1 and sum_nu l'_nu = 0: the momentum change of the step (see step()).
 double GalerkinDiscreteLagrangian::action(double h, Order order, bool forced) {
   const int n = n_;
   const bool sparse = lagrangian_.sparse();
   double S = 0.0;
-  if (order != Order::value) gradient_.setZero();
+  if (order != Order::value) {
+    gradient_.setZero();
+    impulse_.setZero();
+  }
   if (order == Order::hessian && sparse) sparse_.matrix.coeffs().setZero();
   if (order == Order::hessian && !sparse) hessian_.setZero();
   for (int i = 0; i < basis_.phi.rows(); ++i) {
@@ -203,22 +240,43 @@ double GalerkinDiscreteLagrangian::action(double h, Order order, bool forced) {
     const double b = weights_[i];
     S += h * b * L;
     if (order == Order::value) continue;
+    impulse_ += (h * b) * grad_.head(n);
     if (forced) add_forces(i, h, order);
     if (order == Order::hessian && sparse)
       add_sparse_entries(i, h, 0, sparse_values_.data(), static_cast<int>(sparse_values_.size()), h * b);
     for (int nu = 0; nu <= s_; ++nu) {
       const double a = basis_.phi(i, nu), da = basis_.dphi(i, nu);
       gradient_.segment(nu * n, n) += b * (h * a * grad_.head(n) + da * grad_.tail(n));
-      if (order != Order::hessian || sparse) continue;
-      for (int mu = 0; mu <= s_; ++mu) {
-        const double c = basis_.phi(i, mu), dc = basis_.dphi(i, mu);
-        hessian_.block(nu * n, mu * n, n, n) +=
-            b * (h * a * c * hess_.topLeftCorner(n, n) + a * dc * hess_.topRightCorner(n, n) +
-                 da * c * hess_.bottomLeftCorner(n, n) + da * dc / h * hess_.bottomRightCorner(n, n));
+    }
+    if (order == Order::hessian && !sparse) add_hessian(i, h, b);
+  }
+  return S;
+}
+
+// hessian_(nu n + r, mu n + c) += b (l_nu (h l_mu L_qq + l'_mu L_qv) + l'_nu (l_mu L_vq + l'_mu L_vv / h))(r, c)
+// at node i: the same sum as above, factored by column so that each entry costs two products
+// (this runs (s+1)^2 n^2 times per node and Newton iteration).
+void GalerkinDiscreteLagrangian::add_hessian(int i, double h, double b) {
+  const int n = n_, k = 2 * n_;
+  const double* H = hess_.data();  // the 2n x 2n Hessian of L in (q, v), column-major
+  double* column_q = column_.data();
+  double* column_v = column_.data() + n;
+  for (int mu = 0; mu <= s_; ++mu) {
+    const double c = basis_.phi(i, mu), dc = basis_.dphi(i, mu);
+    for (int col = 0; col < n; ++col) {
+      const double* by_q = H + col * k;        // d/dq_col of [L_q; L_v]
+      const double* by_v = H + (n + col) * k;  // d/dv_col of [L_q; L_v]
+      for (int r = 0; r < n; ++r) {
+        column_q[r] = b * (h * c * by_q[r] + dc * by_v[r]);
+        column_v[r] = b * (c * by_q[n + r] + dc / h * by_v[n + r]);
+      }
+      double* target = hessian_.data() + (mu * n + col) * hessian_.rows();
+      for (int nu = 0; nu <= s_; ++nu) {
+        const double a = basis_.phi(i, nu), da = basis_.dphi(i, nu);
+        for (int r = 0; r < n; ++r) target[nu * n + r] += a * column_q[r] + da * column_v[r];
       }
     }
   }
-  return S;
 }
 
 // f_d^nu += h b_i l_nu(c_i) f(t + c_i h, q_i, v_i) (Marsden & West 2001, sec. 3.2, through the
@@ -229,6 +287,7 @@ void GalerkinDiscreteLagrangian::add_forces(int i, double h, Order order) {
                    jacobian ? force_values_.data() : nullptr);
   const double w = h * weights_[i];
   for (int nu = 0; nu <= s_; ++nu) gradient_.segment(nu * n_, n_) += w * basis_.phi(i, nu) * f_;
+  impulse_ += w * f_;
   if (!jacobian) return;
   const int first = static_cast<int>(entries_.size() - force_values_.size());
   if (lagrangian_.sparse())
@@ -312,6 +371,12 @@ void GalerkinDiscreteLagrangian::solve_sparse() {
   update_.head(size) = sparse_.lu.solve(residual_.head(size));
 }
 
+// Newton's method with the exact Jacobian. The residual that passes the test is still used for
+// one more update (its Jacobian is at hand; no evaluation is needed, see gradient_after_update):
+// a residual left at the tolerance, e.g. by a warm start that passes the test at once, has the
+// same sign from step to step and adds up over a run (bench/README.md), where the update takes it
+// to round-off. A solve also ends when an update is below tolerance relative to the offsets
+// q^nu - q^0. The iterations counted are the updates taken.
 void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
                                         int blocks, const double* p0, bool forced) {
   const int size = blocks * n_;
@@ -333,8 +398,8 @@ void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_e
     residuals_.push_back(norm);
     if (!std::isfinite(norm))
       throw NumericalFailure("the Galerkin equations have a non-finite residual", norm);
-    if (options_.converged(norm, scale)) return statistics_.record(iteration);
-    if (iteration == options_.max_iterations)
+    const bool converged = options_.converged(norm, scale);
+    if (!converged && iteration == options_.max_iterations)
       throw NumericalFailure("Newton's method did not converge in " +
                                  std::to_string(options_.max_iterations) + " iterations",
                              norm);
@@ -343,35 +408,69 @@ void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_e
     else
       solve_dense(first_unknown, first_equation, blocks);
     points_.middleCols(first_unknown, blocks).reshaped() -= update;
-    if (options_.converged(update.lpNorm<Eigen::Infinity>(), points_.lpNorm<Eigen::Infinity>())) {
-      action(h, Order::gradient, forced);
+    if (converged || options_.converged(update.lpNorm<Eigen::Infinity>(), points_.lpNorm<Eigen::Infinity>())) {
+      gradient_after_update(h, first_unknown, size, forced);
       return statistics_.record(iteration + 1);
     }
   }
 }
 
-// The initial guess: the previous step's interpolant continued past its end when this step
-// follows it, otherwise a straight line with the velocity of the inverse Legendre transform.
-void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
-  const Eigen::Map<const Eigen::VectorXd> start(q0, n_);
-  if (has_previous_ && previous_h_ == h && previous_.col(s_) == start) {
-    points_.noalias() = previous_ * extrapolation_;
-  } else {
-    lagrangian_.inverse_legendre(q0, p0, velocity_.data(), options_);
-    for (int nu = 0; nu <= s_; ++nu)
-      points_.col(nu) = start + basis_.control_times[nu] * h * velocity_;
+// The gradient (and impulse_) at the points just updated. Dense: from the Hessian at hand, to
+// first order in the update (dS/dq^nu -= sum_mu d2S/dq^nu dq^mu update^mu); the update is at the
+// tolerance here, so the neglected O(|update|^2) term is far below round-off and no evaluation is
+// made. Sparse: the Jacobian holds only the equations' rows, so the gradient is evaluated again.
+void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unknown, int size, bool forced) {
+  if (lagrangian_.sparse()) {
+    action(h, Order::gradient, forced);
+    return;
   }
-  points_.col(0) = start;
+  change_.noalias() = hessian_.middleCols(first_unknown * n_, size) * update_.head(size);
+  gradient_ -= change_;
+  for (int nu = 0; nu <= s_; ++nu) impulse_ -= change_.segment(nu * n_, n_);
 }
 
+// The initial guess: the previous step's interpolant continued past its end when this step
+// follows it, otherwise a straight line with the velocity of the inverse Legendre transform.
+// Offsets from q0 = the last step's q1: q(1 + d_nu) - q1 = sum_mu l_mu(1 + d_nu) (q_prev^mu -
+// q_prev^0) - (q_prev^s - q_prev^0).
+void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
+  const Eigen::Map<const Eigen::VectorXd> start(q0, n_);
+  origin_ = start;
+  if (has_previous_ && previous_h_ == h && previous_end_ == start) {
+    points_.noalias() = previous_ * extrapolation_;
+    points_.colwise() -= previous_.col(s_);
+  } else {
+    lagrangian_.inverse_legendre(q0, p0, velocity_.data(), options_);
+    for (int nu = 0; nu <= s_; ++nu) points_.col(nu) = (basis_.control_times[nu] * h) * velocity_;
+  }
+  points_.col(0).setZero();
+}
+
+// q1 = q0 + (q^s - q^0), and p1 = D2 L_d + f_d^s written as p0 plus its change: the equations
+// sum to sum_nu (dS/dq^nu + f_d^nu) = impulse_ (see action()), so
+//   p1 - p0 = impulse_ - (dS/dq^0 + f_d^0 + p0) - sum_{0 < nu < s} (dS/dq^nu + f_d^nu),
+// the impulse less the residuals of the solved equations. Both sums are compensated across steps
+// (compensated.hpp) when a step continues from the last one's output.
 void GalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double h, double* q1,
                                       double* p1) {
-  if (explicit_) return explicit_step(q0, p0, h, q1, p1);
+  if (explicit_step_ != nullptr) return (this->*explicit_step_)(q0, p0, h, q1, p1);
+  const Eigen::Map<const Eigen::VectorXd> start(q0, n_), momentum(p0, n_);
+  if (!(has_previous_ && previous_end_ == start && end_p_ == momentum)) {
+    carry_q_.setZero();
+    carry_p_.setZero();
+  }
   warm_start(q0, p0, h);
   newton(h, 1, 0, s_, p0, !forces_.empty());
   t_ += h;
-  Eigen::Map<Eigen::VectorXd>(q1, n_) = points_.col(s_);
-  Eigen::Map<Eigen::VectorXd>(p1, n_) = gradient_.segment(s_ * n_, n_);  // p1 = D2 L_d + f_d^s
+  impulse_ -= gradient_.head(n_) + momentum;
+  for (int nu = 1; nu < s_; ++nu) impulse_ -= gradient_.segment(nu * n_, n_);
+  Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);
+  previous_end_ = start;
+  compensated_add(previous_end_, points_.col(s_), carry_q_);
+  end_p_ = momentum;
+  compensated_add(end_p_, impulse_, carry_p_);
+  end = previous_end_;
+  momentum1 = end_p_;
   previous_ = points_;
   previous_h_ = h;
   has_previous_ = true;
@@ -380,8 +479,8 @@ void GalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double
 void GalerkinDiscreteLagrangian::evaluate(const double* q0, const double* q1, double h, double* Ld,
                                           double* D1, double* D2) {
   const Eigen::Map<const Eigen::VectorXd> a(q0, n_), b(q1, n_);
-  for (int nu = 0; nu <= s_; ++nu)
-    points_.col(nu) = a + basis_.control_times[nu] * (b - a);
+  origin_ = a;
+  for (int nu = 0; nu <= s_; ++nu) points_.col(nu) = basis_.control_times[nu] * (b - a);
   if (s_ > 1) newton(h, 1, 1, s_ - 1, nullptr, false);
   const double S = action(h, Order::gradient);
   if (Ld != nullptr) *Ld = S;

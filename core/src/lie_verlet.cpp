@@ -7,6 +7,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "varia/core/compensated.hpp"
 #include "varia/core/so3.hpp"
 
 namespace varia {
@@ -17,15 +18,6 @@ using so3::from_row_major;
 using so3::hat;
 using so3::to_row_major;
 using so3::vee;
-
-// s += increment by Kahan's compensated summation, with the running compensation c.
-template <class Matrix>
-void compensated_add(Matrix& s, const Matrix& increment, Matrix& c) {
-  const Matrix y = increment - c;
-  const Matrix t = s + y;
-  c = (t - s) - y;
-  s = t;
-}
 
 std::string too_far(double h_omega) {
   return "the Lie group velocity Verlet step turns the body too far: F J_d - J_d F^T = hat(g) has "

@@ -26,9 +26,14 @@ EulerLagrangeField::EulerLagrangeField(LagrangianEvaluator& lagrangian)
   inverse_mass_ = mass_.inverse();
 }
 
-MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space)
+MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space, Forces* forces)
     : EulerLagrangeField(lagrangian),
       space_(space),
+      forces_(forces != nullptr && !forces->empty() ? forces : nullptr),
+      force_(n_),
+      force_jacobian_(forces_ ? static_cast<Eigen::Index>(forces_->rows().size()) : 0),
+      position_(n_),
+      force_jet_(n_),
       v_(n_),
       gradient_(2 * n_),
       hessian_(2 * n_, 2 * n_),
@@ -54,14 +59,38 @@ void MechanicalField::velocity(const Jet2* w, Jet2* v) const {
   std::copy(w, w + n_, v);
 }
 
+void MechanicalField::add_forces(const double* y, bool jacobian) {
+  forces_->evaluate(y[2 * n_], y, v_.data(), force_.data(), jacobian ? force_jacobian_.data() : nullptr);
+  gradient_.head(n_) += force_;
+  if (!jacobian) return;
+  for (std::size_t e = 0; e < forces_->rows().size(); ++e)
+    hessian_(forces_->rows()[e], forces_->cols()[e]) += force_jacobian_[static_cast<Eigen::Index>(e)];
+}
+
+void MechanicalField::force(const Jet2* y, const Jet2* v, Jet2* f) {
+  for (int r = 0; r < n_; ++r) {
+    position_[r] = y[r].value;
+    v_[r] = v[r].value;
+  }
+  forces_->evaluate(y[2 * n_].value, position_.data(), v_.data(), force_.data(), force_jacobian_.data());
+  for (int r = 0; r < n_; ++r) f[r] = Jet2(force_[r]);
+  for (std::size_t e = 0; e < forces_->rows().size(); ++e) {
+    const int col = forces_->cols()[e];
+    const Jet2& x = col < n_ ? y[col] : v[col - n_];
+    if (!x.constant()) f[forces_->rows()[e]] += force_jacobian_[static_cast<Eigen::Index>(e)] * (x - x.value);
+  }
+}
+
 Status MechanicalField::eval(const double* y, double* f) noexcept {
   return guard([&] {
     if (space_ == PhaseSpace::cotangent) inverse_mass(y + n_, v_.data());
     else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
     lagrangian_.gradient(y, v_.data(), gradient_.data());
+    if (forced_) add_forces(y, false);
     Eigen::Map<Eigen::VectorXd>(f, n_) = v_;
     if (space_ == PhaseSpace::cotangent) Eigen::Map<Eigen::VectorXd>(f + n_, n_) = gradient_.head(n_);
     else inverse_mass(gradient_.data(), f + n_);
+    if (clock()) f[2 * n_] = 1.0;
   });
 }
 
@@ -69,34 +98,46 @@ Status MechanicalField::eval(const Jet2* y, Jet2* f) noexcept {
   return guard([&] {
     velocity(y + n_, v_jet_.data());
     lagrangian_.gradient_jet(y, v_jet_.data(), nullptr, gradient_jet_.data());
+    if (forced_) {
+      force(y, v_jet_.data(), force_jet_.data());
+      for (int r = 0; r < n_; ++r) gradient_jet_[r] += force_jet_[r];
+    }
     std::copy(v_jet_.begin(), v_jet_.end(), f);
     if (space_ == PhaseSpace::cotangent) std::copy_n(gradient_jet_.begin(), n_, f + n_);
     else inverse_mass(gradient_jet_.data(), f + n_);
+    if (clock()) f[2 * n_] = Jet2(1.0);
   });
 }
 
 // Tangent:   df = [0, I; M^{-1} L_qq, M^{-1} L_qv].
 // Cotangent: df = [0, M^{-1}; L_qq, L_qv M^{-1}]  (v = M^{-1} p).
+// With forces, L_q + f in place of L_q, and the time's row and column zero: t' = 1 is constant,
+// and df/dt (which the Force interface does not give) multiplies only the time's Newton update,
+// which is zero once the stages' times are right (after the first update of an implicit stage
+// solve; the values at convergence and the jets are exact).
 Status MechanicalField::jacobian(const double* y, double* f, double* df) noexcept {
   return guard([&] {
     if (space_ == PhaseSpace::cotangent) inverse_mass(y + n_, v_.data());
     else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
     lagrangian_.hessian(y, v_.data(), gradient_.data(), hessian_.data());
-    Eigen::Map<Eigen::VectorXd> rate(f, 2 * n_);
-    Eigen::Map<Eigen::MatrixXd> J(df, 2 * n_, 2 * n_);
+    if (forced_) add_forces(y, true);
+    const int N = size();
+    Eigen::Map<Eigen::VectorXd> rate(f, N);
+    Eigen::Map<Eigen::MatrixXd> J(df, N, N);
+    J.setZero();
     rate.head(n_) = v_;
-    J.topLeftCorner(n_, n_).setZero();
     if (space_ == PhaseSpace::cotangent) {
-      rate.tail(n_) = gradient_.head(n_);
-      J.topRightCorner(n_, n_) = inverse_mass_;
-      J.bottomLeftCorner(n_, n_) = hessian_.topLeftCorner(n_, n_);
-      J.bottomRightCorner(n_, n_).noalias() = hessian_.topRightCorner(n_, n_) * inverse_mass_;
+      rate.segment(n_, n_) = gradient_.head(n_);
+      J.block(0, n_, n_, n_) = inverse_mass_;
+      J.block(n_, 0, n_, n_) = hessian_.topLeftCorner(n_, n_);
+      J.block(n_, n_, n_, n_).noalias() = hessian_.topRightCorner(n_, n_) * inverse_mass_;
     } else {
-      rate.tail(n_).noalias() = inverse_mass_ * gradient_.head(n_);
-      J.topRightCorner(n_, n_).setIdentity();
-      J.bottomLeftCorner(n_, n_).noalias() = inverse_mass_ * hessian_.topLeftCorner(n_, n_);
-      J.bottomRightCorner(n_, n_).noalias() = inverse_mass_ * hessian_.topRightCorner(n_, n_);
+      rate.segment(n_, n_).noalias() = inverse_mass_ * gradient_.head(n_);
+      J.block(0, n_, n_, n_).setIdentity();
+      J.block(n_, 0, n_, n_).noalias() = inverse_mass_ * hessian_.topLeftCorner(n_, n_);
+      J.block(n_, n_, n_, n_).noalias() = inverse_mass_ * hessian_.topRightCorner(n_, n_);
     }
+    if (clock()) rate[2 * n_] = 1.0;
   });
 }
 

@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "varia/core/rotation_field.hpp"
+
 namespace varia {
 
 namespace {
@@ -11,14 +13,29 @@ PhaseSpace phase_space(ShootingForm form) {
   return form == ShootingForm::lagrangian ? PhaseSpace::tangent : PhaseSpace::cotangent;
 }
 
-Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian) {
-  require_vector_space(manifold, lagrangian, "the shooting construction");
+Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingForm form) {
+  if (manifold.is_vector_space())
+    require_vector_space(manifold, lagrangian, "the shooting construction");
+  else if (form != ShootingForm::lagrangian)
+    throw std::invalid_argument("the shooting construction on a Lie group takes the lagrangian form "
+                                "(the Euler-Lagrange field on TQ) only");
   if (2 * manifold.dim() > kMaxJetVariables)
     throw std::invalid_argument("the shooting construction differentiates the propagation with "
                                 "jets of at most " + std::to_string(kMaxJetVariables) +
-                                " variables (q0, v0): it takes dim <= " +
+                                " variables (eta, w0): it takes dim <= " +
                                 std::to_string(kMaxJetVariables / 2));
   return lagrangian;
+}
+
+// The Euler-Lagrange field of the manifold's phase space: on R^n in (q, v) or (q, p), with the
+// forces; on a Lie group (TSO(3) = SO(3)-shaped, rotation_field.hpp) in (R, Omega).
+std::unique_ptr<EulerLagrangeField> field_of(const Manifold& manifold, LagrangianEvaluator& lagrangian,
+                                            ShootingForm form, Forces& forces) {
+  if (manifold.is_vector_space())
+    return std::make_unique<MechanicalField>(lagrangian, phase_space(form), &forces);
+  if (!forces.empty())
+    throw std::invalid_argument("the shooting construction takes forces on vector spaces only");
+  return std::make_unique<RotationField>(manifold, lagrangian);
 }
 
 }  // namespace
@@ -34,12 +51,16 @@ ShootingForm shooting_form(const std::string& name) {
 ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian,
                                                        Quadrature& quadrature,
                                                        OneStepMethod& method, ShootingForm form,
-                                                       SolverOptions options)
-    : lagrangian_(checked(manifold, lagrangian)),
-      field_(lagrangian_, phase_space(form)),
+                                                       SolverOptions options, std::vector<Force*> forces)
+    : manifold_(manifold),
+      lagrangian_(checked(manifold, lagrangian, form)),
+      forces_(std::move(forces), manifold.dim(), manifold.dim()),
+      field_(field_of(manifold, lagrangian_, form, forces_)),
+      mechanical_(dynamic_cast<MechanicalField*>(field_.get())),
       method_(method),
       form_(form),
       options_(options),
+      m_(manifold.point_size()),
       n_(manifold.dim()) {
   method_.set_solver(options.tolerance, options.max_iterations);
   // The nodes 0 = c_0 < ... < c_n = 1 with zero weights where the rule has no node (paper, sec. 3).
@@ -69,11 +90,21 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
                                   "first derivative of the integrand only");
     }
   }
-  state_.resize(2 * n_);
-  next_.resize(2 * n_);
+  if (!forces_.empty() && type_2())
+    throw std::invalid_argument("the shooting construction takes forces in the lagrangian and "
+                                "hamiltonian forms (Type I generating functions), not type-2");
+  if ((!forces_.empty() || mechanical_ == nullptr) && (start_correction_ != 0.0 || end_correction_ != 0.0))
+    throw std::invalid_argument("the shooting construction takes end-derivative quadratures on vector spaces "
+                                "without forces only");
+  state_.resize(field_->size());
+  next_.resize(field_->size());
+  target_.resize(m_);
+  force_.resize(n_);
+  alpha_.resize(2 * n_);
+  work_jacobian_.resize(2 * n_, 2 * n_);
   v_.resize(n_);
   acceleration_.resize(n_);
-  gradient_.resize(2 * n_);
+  gradient_.resize(m_ + n_);
   boundary_.resize(n_);
   w_.resize(n_);
   lambda_.resize(n_);
@@ -96,28 +127,64 @@ void ShootingDiscreteLagrangian::accumulate(int node, double h, Jet2& S) {
   const bool first = node == 0, last = node + 1 == static_cast<int>(nodes_.size());
   const double correction = first ? start_correction_ : last ? end_correction_ : 0.0;
   if (weights_[node] == 0.0 && correction == 0.0) return;
-  field_.velocity(&state_[n_], v_.data());
+  if (mechanical_ != nullptr) mechanical_->velocity(&state_[m_], v_.data());
+  else std::copy_n(state_.begin() + m_, n_, v_.begin());
   Jet2 L;
   lagrangian_.gradient_jet(state_.data(), v_.data(), &L, gradient_.data());
   S += (h * weights_[node]) * L;
+  if (forced_) add_work(h * weights_[node]);
   if (correction == 0.0) return;
-  field_.inverse_mass(gradient_.data(), acceleration_.data());
+  field_->inverse_mass(gradient_.data(), acceleration_.data());
   Jet2 rate;
   for (int r = 0; r < n_; ++r) rate += gradient_[r] * v_[r] + gradient_[n_ + r] * acceleration_[r];
   S += (h * h * correction) * rate;
 }
 
-// Propagates (q^0, w^0) = (q0, w0) as jets in those 2n variables through the nodes, then forms
+// The virtual work of the forces at node i, weight = h b_i: W_x += weight q^i_x^T f_i and
+// dW_x/dx += weight (sum_r f_ir q^i_r,xx + q^i_x^T f_i,x), f_i = f(t + c_i h, q^i, v^i) at jets
+// (Marsden & West 2001, sec. 3.2, through the quadrature; see shooting.hpp).
+void ShootingDiscreteLagrangian::add_work(double weight) {
+  mechanical_->force(state_.data(), v_.data(), force_.data());
+  for (int r = 0; r < n_; ++r) {
+    const Jet2& q = state_[r];
+    const double f = weight * force_[r].value;
+    alpha_ += f * q.gradient;
+    work_jacobian_ += f * q.hessian;
+    if (!force_[r].constant()) work_jacobian_.noalias() += weight * q.gradient * force_[r].gradient.transpose();
+  }
+}
+
+// q^0 = q0 exp(eta) at eta = 0 as jets in x = (eta, w0), the natural chart at q0 (paper, sec. 2
+// "Natural charts"): eta carries D1 L_d, left-trivialized on a Lie group. On a vector space the
+// chart is q0 + eta; otherwise the manifold's chart_jets gives q0 exp(eta) exp(xi) in (eta, xi),
+// whose xi-derivatives (xi = 0) are dropped: the variables n..2n-1 are w0 here.
+void ShootingDiscreteLagrangian::start_point(const double* q0) {
+  if (manifold_.is_vector_space()) {
+    for (int r = 0; r < n_; ++r) state_[r] = Jet2::variable(q0[r], 2 * n_, r);
+    return;
+  }
+  check(manifold_.chart_jets(q0, zero_.data(), zero_.data(), state_.data(), nullptr), "manifold chart at jets");
+  for (int r = 0; r < m_; ++r) {
+    if (state_[r].constant()) continue;
+    state_[r].gradient.tail(n_).setZero();
+    state_[r].hessian.bottomRows(n_).setZero();
+    state_[r].hessian.rightCols(n_).setZero();
+  }
+}
+
+// Propagates (q^0, w^0) = (q0 exp(eta), w0) as jets in x = (eta, w0) through the nodes, then forms
 // the generating function G and the boundary quantity B of the form.
 void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, double h) {
-  for (int r = 0; r < n_; ++r) {
-    state_[r] = Jet2::variable(q0[r], 2 * n_, r);
-    state_[n_ + r] = Jet2::variable(w0[r], 2 * n_, n_ + r);
-  }
+  start_point(q0);
+  for (int r = 0; r < n_; ++r) state_[m_ + r] = Jet2::variable(w0[r], 2 * n_, n_ + r);
+  if (mechanical_ != nullptr && mechanical_->clock()) state_[2 * n_] = Jet2(t_);
+  if (mechanical_ != nullptr) mechanical_->set_forced(forced_);
+  alpha_.setZero();
+  work_jacobian_.setZero();
   Jet2 S;
   accumulate(0, h, S);
   for (std::size_t i = 1; i < nodes_.size(); ++i) {
-    field_.step(method_, (nodes_[i] - nodes_[i - 1]) * h, state_.data(), next_.data(), stages_);
+    field_->step(method_, (nodes_[i] - nodes_[i - 1]) * h, state_.data(), next_.data(), stages_);
     std::swap(state_, next_);
     accumulate(static_cast<int>(i), h, S);
   }
@@ -127,21 +194,39 @@ void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, doubl
     std::copy_n(state_.begin() + n_, n_, boundary_.begin());
   } else {
     generating_ = S;
-    std::copy_n(state_.begin(), n_, boundary_.begin());
+    boundary();
   }
+  alpha_ += generating_.gradient;
 }
 
-// lambda = B_w^{-T} G_w, D1 = G_q - B_q^T lambda, Phi = Hess G - sum_r lambda_r Hess B_r.
+// B = local(q1, q^n), the natural chart at the far end (paper, sec. 2 "Natural charts"): at
+// B = 0, lambda = dG/dB is D2 L_d left-trivialized at q1 (q1 exp(B) = q^n). The chart is at the
+// given q1 when evaluating L_d, and at q^n's own value in a step (where q1 is the outcome), so
+// that B = 0 there; its second derivatives enter Phi. On a vector space B = q^n - q1, taken as
+// q^n (the targets subtract q1).
+void ShootingDiscreteLagrangian::boundary() {
+  if (manifold_.is_vector_space()) {
+    std::copy_n(state_.begin(), n_, boundary_.begin());
+    return;
+  }
+  if (target_is_end_)
+    for (int r = 0; r < m_; ++r) target_[r] = state_[r].value;
+  check(manifold_.local_jets(target_.data(), state_.data(), boundary_.data()), "manifold chart at jets");
+}
+
+// lambda = B_w^{-T} alpha_w, D1 = alpha_q - B_q^T lambda, Phi = d alpha/dx - sum_r lambda_r Hess B_r,
+// alpha = G_x (+ W_x with forces; Phi's rows are alpha's components, its columns the variables).
 void ShootingDiscreteLagrangian::differentiate() {
   for (int r = 0; r < n_; ++r) {
     Bq_.row(r) = boundary_[r].gradient.head(n_).transpose();
     Bw_.row(r) = boundary_[r].gradient.tail(n_).transpose();
   }
   BwT_lu_.compute(Bw_.transpose());
-  lambda_.noalias() = BwT_lu_.solve(generating_.gradient.tail(n_));
-  D1_ = generating_.gradient.head(n_);
+  lambda_.noalias() = BwT_lu_.solve(alpha_.tail(n_));
+  D1_ = alpha_.head(n_);
   D1_.noalias() -= Bq_.transpose() * lambda_;
   phi_ = generating_.hessian;
+  if (forced_) phi_ += work_jacobian_;
   for (int r = 0; r < n_; ++r) phi_ -= lambda_[r] * boundary_[r].hessian;
 }
 
@@ -202,21 +287,40 @@ void ShootingDiscreteLagrangian::solve(const double* q0, double h, Target target
 // v0 = M^{-1} p0 (Lagrangian form), or w0 = p^0 guessed as p0 (Hamiltonian forms).
 void ShootingDiscreteLagrangian::step(const double* q0, const double* p0, double h, double* q1,
                                       double* p1) {
-  if (form_ == ShootingForm::lagrangian) field_.inverse_mass(p0, w_.data());
+  forced_ = !forces_.empty();
+  if (form_ == ShootingForm::lagrangian) field_->inverse_mass(p0, w_.data());
   else w_ = Eigen::Map<const Eigen::VectorXd>(p0, n_);
+  target_is_end_ = true;
   solve(q0, h, Target::momentum, p0);
-  Eigen::Map<Eigen::VectorXd> q(q1, n_), p(p1, n_);
-  for (int r = 0; r < n_; ++r) (type_2() ? p : q)[r] = boundary_[r].value;
-  (type_2() ? q : p) = lambda_;
+  Eigen::Map<Eigen::VectorXd> p(p1, n_);
+  if (type_2()) {
+    for (int r = 0; r < n_; ++r) p[r] = boundary_[r].value;
+    Eigen::Map<Eigen::VectorXd>(q1, n_) = lambda_;
+  } else {
+    for (int r = 0; r < m_; ++r) q1[r] = state_[r].value;
+    p = lambda_;  // with forces p1 = D2 L_d + f_d^+
+  }
+  t_ += h;
 }
 
-// From the straight line's velocity (q1 - q0)/h (times M for a momentum).
+const EvaluationCounters& ShootingDiscreteLagrangian::evaluations() const {
+  counters_ = lagrangian_.counters();
+  counters_.force = forces_.evaluations();
+  return counters_;
+}
+
+// From the velocity local(q0, q1)/h of the chart's straight line (times M for a momentum).
 void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, double h,
                                           double* Ld, double* D1, double* D2) {
-  const Eigen::Map<const Eigen::VectorXd> a(q0, n_), b(q1, n_);
-  w_ = (b - a) / h;
-  if (form_ != ShootingForm::lagrangian) w_ = field_.mass() * w_;
-  solve(q0, h, type_2() ? Target::lambda : Target::boundary, q1);
+  forced_ = false;  // L_d alone: the forces are not part of it
+  check(manifold_.local(q0, q1, w_.data()), "manifold chart");
+  w_ /= h;
+  if (form_ != ShootingForm::lagrangian) w_ = field_->mass() * w_;
+  target_is_end_ = false;
+  std::copy_n(q1, m_, target_.begin());
+  // On a vector space B = q^n against q1; through the chart at q1, B = local(q1, q^n) against 0.
+  solve(q0, h, type_2() ? Target::lambda : Target::boundary,
+        manifold_.is_vector_space() ? q1 : zero_.data());
   double p1_q1 = 0.0;
   for (int r = 0; r < n_; ++r) p1_q1 += boundary_[r].value * lambda_[r];
   if (Ld != nullptr) *Ld = type_2() ? p1_q1 - generating_.value : generating_.value;

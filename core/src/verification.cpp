@@ -16,10 +16,11 @@ Predictions predict_galerkin(const Composition& c) {
   Predictions p;
   const int order = std::min(2 * c.degree, c.quadrature_order);
   p.ld_order = p.global_order = order;
-  p.self_adjoint = c.quadrature_symmetric && c.control_times_symmetric;
+  if (!c.natural_chart) p.self_adjoint = c.quadrature_symmetric && c.control_times_symmetric;
   p.symplectic = p.energy_bounded = true;
   p.reason = "Galerkin (sec. 2): order min(2s, quadrature order); self-adjoint for a symmetric "
-             "rule and control times; G-invariant L_d from an equivariant interpolant";
+             "rule and control times (on a vector space: the natural chart at q0 of a Lie group "
+             "is not symmetric); G-invariant L_d from an equivariant interpolant";
   return p;
 }
 
@@ -206,19 +207,57 @@ void run(DiscreteHamiltonianMap& map, std::vector<double> q, std::vector<double>
 
 namespace {
 
-// Central-difference Jacobian of the one-step map with difference step delta.
-Eigen::MatrixXd jacobian(DiscreteHamiltonianMap& map, const double* q0, const double* p0, double h,
-                         double delta) {
-  const int n = map.dim();
+// The one-step map in canonical coordinates z = (xi, pi) of T*Q: xi in the natural chart at
+// `base`, pi = B^T mu the chart's conjugate momentum, where mu is the (left-trivialized) momentum
+// and B = d velocity / d xi_dot = dexp_{-xi} (Manifold::chart_jets; the identity on a vector
+// space, where z = (q - base, p)).
+class CanonicalChart {
+ public:
+  CanonicalChart(DiscreteHamiltonianMap& map, Manifold& manifold, const double* base)
+      : map_(map), manifold_(manifold), base_(base, base + manifold.point_size()),
+        n_(manifold.dim()), q_(manifold.point_size()), q1_(manifold.point_size()), mu_(n_), mu1_(n_),
+        B_(n_, n_), jets_(n_) {}
+  void step(const Eigen::VectorXd& z, double h, Eigen::VectorXd& out) {
+    check(manifold_.retract(base_.data(), z.data(), q_.data()), "manifold retract");
+    chart_momentum_matrix(z.data());
+    mu_ = B_.transpose().partialPivLu().solve(z.tail(n_));
+    map_.step(q_.data(), mu_.data(), h, q1_.data(), mu1_.data());
+    check(manifold_.local(base_.data(), q1_.data(), out.data()), "manifold local");
+    chart_momentum_matrix(out.data());
+    out.tail(n_) = B_.transpose() * mu1_;
+  }
+
+ private:
+  void chart_momentum_matrix(const double* xi) {
+    if (manifold_.is_vector_space()) {
+      B_.setIdentity();
+      return;
+    }
+    const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
+    check(manifold_.chart_jets(base_.data(), xi, zero.data(), nullptr, jets_.data()), "manifold chart_jets");
+    for (int k = 0; k < n_; ++k) B_.row(k) = jets_[k].gradient.tail(n_).transpose();
+  }
+  DiscreteHamiltonianMap& map_;
+  Manifold& manifold_;
+  std::vector<double> base_;
+  int n_;
+  std::vector<double> q_, q1_;
+  Eigen::VectorXd mu_, mu1_;
+  Eigen::MatrixXd B_;
+  std::vector<Jet2> jets_;
+};
+
+// Central-difference Jacobian of the one-step map in canonical chart coordinates at
+// (xi, pi) = (0, p0), with difference step delta.
+Eigen::MatrixXd jacobian(CanonicalChart& chart, const double* p0, int n, double h, double delta) {
   Eigen::MatrixXd M(2 * n, 2 * n);
-  Eigen::VectorXd z(2 * n), plus(2 * n), minus(2 * n);
-  for (int i = 0; i < n; ++i) z[i] = q0[i], z[n + i] = p0[i];
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * n), plus(2 * n), minus(2 * n);
+  for (int i = 0; i < n; ++i) z[n + i] = p0[i];
   for (int j = 0; j < 2 * n; ++j) {
     for (double sign : {1.0, -1.0}) {
       Eigen::VectorXd w = z;
       w[j] += sign * delta;
-      Eigen::VectorXd& out = sign > 0 ? plus : minus;
-      map.step(w.data(), w.data() + n, h, out.data(), out.data() + n);
+      chart.step(w, h, sign > 0 ? plus : minus);
     }
     M.col(j) = (plus - minus) / (2 * delta);
   }
@@ -235,12 +274,14 @@ double defect(const Eigen::MatrixXd& M) {
 
 }  // namespace
 
-SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, const double* q0,
-                                         const double* p0, double h) {
+SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& manifold,
+                                         const double* q0, const double* p0, double h) {
   // Richardson: (4 M(delta/2) - M(delta)) / 3 cancels the O(delta^2) term of central differences.
   const double delta = 1e-3;
+  const int n = manifold.dim();
+  CanonicalChart chart(map, manifold, q0);
   auto richardson = [&](double d) {
-    return Eigen::MatrixXd((4.0 * jacobian(map, q0, p0, h, d / 2) - jacobian(map, q0, p0, h, d)) / 3.0);
+    return Eigen::MatrixXd((4.0 * jacobian(chart, p0, n, h, d / 2) - jacobian(chart, p0, n, h, d)) / 3.0);
   };
   const double coarse = defect(richardson(delta)), fine = defect(richardson(delta / 2));
   return {fine, std::abs(fine - coarse) + 1e-13};

@@ -9,6 +9,7 @@
 #include "registry.hpp"
 #include "varia/core/composite.hpp"
 #include "varia/core/galerkin.hpp"
+#include "varia/core/galerkin_chart.hpp"
 #include "varia/core/lie_verlet.hpp"
 #include "varia/core/one_step_map.hpp"
 #include "varia/core/shooting.hpp"
@@ -43,6 +44,22 @@ void describe_quadrature(const Quadrature& quadrature, Composition& composition)
   composition.quadrature_symmetric = quadrature.symmetric();
 }
 
+// On a Lie group the interpolant lives in the natural chart at q0 (core/galerkin_chart.hpp).
+void lie_group_galerkin(const Scene& scene, std::vector<double> times, Assembly& a) {
+  if (!a.forces.empty())
+    throw InputError("/system/forces: the galerkin construction takes forces on vector spaces only, not on " +
+                     scene.manifold.type);
+  a.composition.natural_chart = true;
+  try {
+    auto map = std::make_unique<LieGroupGalerkinDiscreteLagrangian>(*a.manifold, *a.lagrangian, *a.quadrature,
+                                                                    std::move(times), scene.solver, scene.reduced);
+    a.discrete_lagrangian = map.get();
+    a.map = std::move(map);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(std::string(scene.reduced ? "/method/reduced: " : "/method: ") + e.what());
+  }
+}
+
 void galerkin(const Scene& scene, Registry& registry, Assembly& a) {
   a.quadrature = make<Quadrature>(registry, *scene.quadrature, context_of(scene, *a.manifold));
   auto times = scene.control_times ? *scene.control_times : equispaced_control_times(scene.degree);
@@ -50,6 +67,10 @@ void galerkin(const Scene& scene, Registry& registry, Assembly& a) {
   a.composition.degree = scene.degree;
   a.composition.control_times_symmetric = symmetric_times(times);
   describe_quadrature(*a.quadrature, a.composition);
+  if (!a.manifold->is_vector_space()) return lie_group_galerkin(scene, std::move(times), a);
+  if (scene.reduced)
+    throw InputError("/method/reduced: the reduced (Euler-Poincare) form is for Lie groups; " + scene.manifold.type +
+                     " is a vector space");
   std::vector<Force*> forces;
   for (const auto& force : a.forces) forces.push_back(force.get());
   auto map = std::make_unique<GalerkinDiscreteLagrangian>(*a.manifold, *a.lagrangian, *a.quadrature,
@@ -80,8 +101,10 @@ void shooting(const Scene& scene, Registry& registry, Assembly& a) {
   one_step_method(scene, registry, a);
   a.composition.construction = Composition::Construction::shooting;
   describe_quadrature(*a.quadrature, a.composition);
+  std::vector<Force*> forces;
+  for (const auto& force : a.forces) forces.push_back(force.get());
   auto map = std::make_unique<ShootingDiscreteLagrangian>(*a.manifold, *a.lagrangian, *a.quadrature, *a.one_step,
-                                                          shooting_form(scene.form), scene.solver);
+                                                          shooting_form(scene.form), scene.solver, std::move(forces));
   a.discrete_lagrangian = map.get();
   a.map = std::move(map);
 }
@@ -107,12 +130,13 @@ const std::map<std::string, Construction>& constructions() {
 }
 
 // Spec "Composed systems": forces enter through the discrete Lagrange-d'Alembert principle, which
-// the galerkin construction implements (core/galerkin.hpp).
+// the galerkin and shooting constructions implement (core/galerkin.hpp, core/shooting.hpp).
 void create_forces(const Scene& scene, Registry& registry, Assembly& a) {
   if (scene.forces.empty()) return;
   a.composition.forced = true;
-  if (scene.construction != "galerkin")
-    throw InputError(fmt::format("/system/forces: forces are taken by construction 'galerkin' only, not '{}'",
+  if (scene.construction != "galerkin" && scene.construction != "shooting")
+    throw InputError(fmt::format("/system/forces: forces are taken by constructions 'galerkin' and 'shooting' "
+                                 "only (the discrete Lagrange-d'Alembert principle), not '{}'",
                                  scene.construction));
   for (const auto& spec : scene.forces) a.forces.push_back(make<Force>(registry, spec, context_of(scene, *a.manifold)));
 }

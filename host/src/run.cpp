@@ -225,6 +225,14 @@ class Stepper {
   bool observable_failed_ = false;
 };
 
+// The failure's residual in the run record: its number, or where it is not finite (a non-finite
+// value ended the run, or a residual was not applicable) the string "nan", "inf" or "-inf", which
+// JSON has no number for (docs/hard-cases.md).
+json residual_json(double residual) {
+  if (std::isfinite(residual)) return residual;
+  return std::isnan(residual) ? "nan" : residual > 0 ? "inf" : "-inf";
+}
+
 }  // namespace
 
 void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options) {
@@ -234,7 +242,7 @@ void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry,
   if (failure)
     record["failure"] = {{"step", failure->step},
                          {"t", failure->t},
-                         {"residual", failure->residual},
+                         {"residual", residual_json(failure->residual)},
                          {"message", failure->message}};
   if (options.summary) write_json_file(*options.summary, record);
   if (options.plot) stepper.plot()->write(*options.plot);

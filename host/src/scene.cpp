@@ -62,6 +62,7 @@ void read_method(const json& method, Scene& scene) {
   scene.one_step = optional_plugin(method, "one_step", "one_step");
   scene.degree = method.value("degree", 0);
   scene.form = method.value("form", scene.form);
+  scene.reduced = method.value("reduced", false);
   if (method.contains("control_times")) {
     scene.control_times = method["control_times"].get<std::vector<double>>();
     check_control_times(*scene.control_times, scene.degree);

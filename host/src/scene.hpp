@@ -36,6 +36,7 @@ struct Scene {
   std::optional<PluginSpec> quadrature, one_step;
   int degree = 0;                                    // galerkin
   std::optional<std::vector<double>> control_times;  // galerkin, checked against degree
+  bool reduced = false;                              // galerkin on a Lie group
   std::string form = "lagrangian";                   // shooting
   std::string group_solver = "cayley";               // lie-verlet
   SolverOptions solver;

@@ -63,6 +63,26 @@ class Rn final : public varia::Manifold {
     return nullptr;
   }
 
+  // The affine chart at jets: point q0 + eta + xi in (eta, xi), velocity xi_dot in (xi, xi_dot).
+  varia::Status chart_jets(const double* q0, const double* xi, const double* xi_dot,
+                           varia::Jet2* point, varia::Jet2* velocity) noexcept override {
+    if (2 * n_ > varia::kMaxJetVariables) return "the chart of R^n at jets needs n <= 4";
+    for (int i = 0; i < n_; ++i) {
+      if (point != nullptr) {
+        point[i] = varia::Jet2::variable(q0[i] + xi[i], 2 * n_, i);
+        point[i].gradient(n_ + i) = 1.0;
+      }
+      if (velocity != nullptr) velocity[i] = varia::Jet2::variable(xi_dot[i], 2 * n_, n_ + i);
+    }
+    return nullptr;
+  }
+
+  // The affine chart's inverse at jets: xi = q - q0.
+  varia::Status local_jets(const double* q0, const varia::Jet2* q, varia::Jet2* xi) noexcept override {
+    for (int i = 0; i < n_; ++i) xi[i] = q[i] - q0[i];
+    return nullptr;
+  }
+
   bool contains(const double* q, char* why, int why_size) noexcept override {
     for (int i = 0; i < n_; ++i) {
       if (std::isfinite(q[i])) continue;

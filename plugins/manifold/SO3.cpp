@@ -52,6 +52,24 @@ class SO3 final : public varia::Manifold {
     return nullptr;
   }
 
+  varia::Status chart_jets(const double* q0, const double* xi, const double* xi_dot,
+                           varia::Jet2* point, varia::Jet2* velocity) noexcept override {
+    varia::so3::chart_jets(q0, xi, xi_dot, point, velocity);
+    return nullptr;
+  }
+
+  // log(R0^T R) at jets (so3::log is templated on the scalar).
+  varia::Status local_jets(const double* q0, const varia::Jet2* q, varia::Jet2* xi) noexcept override {
+    using JetMatrix = varia::so3::Matrix3<varia::Jet2>;
+    JetMatrix R;
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) R(r, c) = q[3 * r + c];
+    const JetMatrix D = from_row_major(q0).transpose().cast<varia::Jet2>() * R;
+    const varia::so3::Vector3<varia::Jet2> w = varia::so3::log(D);
+    for (int i = 0; i < 3; ++i) xi[i] = w(i);
+    return nullptr;
+  }
+
   bool contains(const double* q, char* why, int why_size) noexcept override {
     for (int i = 0; i < 9; ++i)
       if (!std::isfinite(q[i])) return explain(why, why_size, "entry %d of R is not finite", i);

@@ -76,6 +76,11 @@ struct Rotations : Manifold {
     Eigen::Map<Eigen::Vector3d>{xi} = so3::log(D);
     return nullptr;
   }
+  Status chart_jets(const double* q0, const double* xi, const double* xi_dot, Jet2* point,
+                    Jet2* velocity) noexcept override {
+    so3::chart_jets(q0, xi, xi_dot, point, velocity);
+    return nullptr;
+  }
   bool contains(const double*, char*, int) noexcept override { return true; }
 };
 

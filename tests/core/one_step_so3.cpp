@@ -19,12 +19,6 @@ using namespace varia::testing;
 
 namespace {
 
-std::shared_ptr<OneStepMethod> crouch_grossman(int order) {
-  static const sdk::conformance::LoadedPlugin plugin(
-      std::filesystem::path(VARIA_BUILD_DIR) / "lib/varia/plugins/one_step_crouch_grossman.so");
-  return plugin.create<OneStepMethod>({{"order", order}});
-}
-
 sdk::RungeKutta explicit_midpoint() { return {sdk::explicit_midpoint(), 2, false}; }
 sdk::RungeKutta implicit_midpoint() { return {sdk::collocation_tableau({0.5}), 2, true}; }
 

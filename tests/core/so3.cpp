@@ -2,14 +2,22 @@
 
 #include <doctest/doctest.h>
 
+#include <Eigen/Geometry>
 #include <Eigen/LU>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <random>
+#include <string>
 #include <unsupported/Eigen/AutoDiff>
 #include <vector>
 
+#include "core/fixtures.hpp"
+#include "varia/core/lie_verlet.hpp"
+
 using namespace varia;
+using varia::testing::Rotations;
+using varia::testing::Top;
 using Eigen::Matrix3d;
 using Eigen::Vector3d;
 
@@ -120,5 +128,77 @@ TEST_CASE("so3 trivialize gives the derivative along left-invariant directions")
   for (int a = 0; a < 3; ++a) {
     const Matrix3d direction = R * so3::hat(Vector3d(Vector3d::Unit(a)));
     CHECK(tau(a) == doctest::Approx((G.array() * direction.array()).sum()).epsilon(1e-15));
+  }
+}
+
+// Rotations by theta = pi - delta, delta = 1e-3 .. 1e-8, built independently of so3:: from the unit
+// quaternion (sin(delta/2), cos(delta/2) n) by Eigen's Quaterniond; theta n and tan(theta/2) n =
+// n / tan(delta/2) are then known to round-off without forming pi - delta's complement.
+TEST_CASE("so3 log and the Cayley inverse within 1e-8 .. 1e-3 of pi against independent formulas") {
+  double worst_log = 0, worst_exp = 0, worst_cayley = 0, worst_round_trip = 0;
+  for (const Vector3d& n : directions(20))
+    for (double delta : {1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8}) {
+      const Eigen::Quaterniond quaternion(std::sin(delta / 2), std::cos(delta / 2) * n.x(),
+                                          std::cos(delta / 2) * n.y(), std::cos(delta / 2) * n.z());
+      const Matrix3d R = quaternion.toRotationMatrix();
+      const Vector3d w = so3::log(R);
+      const Vector3d f = so3::cayley_inverse(R), f_exact = n / std::tan(delta / 2);
+      CAPTURE(delta);
+      worst_log = std::max(worst_log, (w - (pi - delta) * n).norm());
+      worst_exp = std::max(worst_exp, (so3::exp(w) - R).norm());
+      worst_cayley = std::max(worst_cayley, (f - f_exact).norm() / f_exact.norm() / (1e-16 / delta));
+      worst_round_trip = std::max(worst_round_trip, (so3::cayley(f) - R).norm());
+    }
+  MESSAGE("near pi: |log R - theta n| ", worst_log, ", ||exp(log R) - R|| ", worst_exp,
+          ", |cay^-1 R - f|/|f| in units of 1e-16/delta ", worst_cayley, ", ||cay(cay^-1 R) - R|| ",
+          worst_round_trip);
+  CHECK(worst_log < 4e-15);
+  CHECK(worst_exp < 4e-15);
+  // tan(theta/2) n has condition 1/delta in theta; vee(F - F^T)/(1 + tr F) alone lost 1/delta^2
+  // (infinite at delta = 1e-8, where 1 + tr F rounds to 0).
+  CHECK(worst_cayley < 4);
+  CHECK(worst_round_trip < 4e-15);
+}
+
+// The free body J = (1, 2, 3) spinning about its principal axis e3 at omega = 0.01 takes, with
+// h = 0.01, LGVI steps F = rotation about e3 by phi = asin(h omega) (paper, sec. 2 example:
+// vee(F J_d - J_d F^T) = h Pi has third component (d1 + d2) sin phi = J3 sin phi). From
+// R0 = Rz(pi - 2e-3 + 5e-9), R_k = Rz(pi - 2e-3 + 5e-9 + k phi) passes through half a turn in 40 steps,
+// at angles 1e-4 .. 1e-3 and 5e-9 from pi.
+TEST_CASE("lgvi turning a body through a half turn keeps orthogonality at round-off and log exact") {
+  for (auto solver : {LieVerletSolver::cayley, LieVerletSolver::exp}) {
+    Rotations group;
+    Top body(Vector3d(1, 2, 3), 0.0, Vector3d::Zero());
+    LieGroupVelocityVerlet lgvi(group, body, solver, {});
+    const double h = 0.01, omega = 0.01, theta0 = pi - 2e-3 + 5e-9, phi = std::asin(h * omega);
+    const auto rz = [](double a) {
+      Matrix3d R;
+      R << std::cos(a), -std::sin(a), 0, std::sin(a), std::cos(a), 0, 0, 0, 1;
+      return R;
+    };
+    std::array<double, 9> q, q1;
+    std::array<double, 3> p = {0.0, 0.0, 3 * omega}, p1;
+    so3::to_row_major(rz(theta0), q.data());
+    double orthogonality = 0, attitude = 0, logarithm = 0, closest = 1;
+    for (int k = 1; k <= 40; ++k) {
+      lgvi.step(q.data(), p.data(), h, q1.data(), p1.data());
+      q = q1;
+      p = p1;
+      const Matrix3d R = so3::from_row_major(q.data());
+      const double angle = theta0 + k * phi;  // in (pi - 2e-3, pi + 2e-3)
+      orthogonality = std::max(orthogonality, so3::orthogonality_error(R));
+      attitude = std::max(attitude, (R - rz(angle)).norm());
+      // log R = angle e3 below pi, (angle - 2 pi) e3 past it.
+      const double wrapped = angle <= pi ? angle : angle - 2 * pi;
+      logarithm = std::max(logarithm, (so3::log(R) - wrapped * Vector3d::UnitZ()).norm());
+      closest = std::min(closest, std::abs(angle - pi));
+    }
+    MESSAGE(std::string(solver == LieVerletSolver::cayley ? "cayley" : "exp"), ": half turn, closest to pi ",
+            closest, ", max ||I - R^T R|| ", orthogonality, ", max ||R - Rz|| ", attitude,
+            ", max |log R - w| ", logarithm);
+    CHECK(closest < 1e-8);
+    CHECK(orthogonality < 4e-15);
+    CHECK(attitude < 1e-14);
+    CHECK(logarithm < 1e-14);
   }
 }

@@ -8,10 +8,14 @@
 #include <array>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
+#include <filesystem>
+#include <memory>
 #include <vector>
 
 #include "core/fixtures.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/one_step.hpp"
+#include "varia/sdk/conformance/loader.hpp"
 
 namespace varia::testing {
 
@@ -82,6 +86,13 @@ inline State integrate(DiscreteHamiltonianMap& map, const State& start, double h
     y = next;
   }
   return y;
+}
+
+// The crouch-grossman one-step plugin of the given order (2 or 3), from the build tree.
+inline std::shared_ptr<OneStepMethod> crouch_grossman(int order) {
+  static const sdk::conformance::LoadedPlugin plugin(
+      std::filesystem::path(VARIA_BUILD_DIR) / "lib/varia/plugins/one_step_crouch_grossman.so");
+  return plugin.create<OneStepMethod>({{"order", order}});
 }
 
 inline Vector3d spatial_momentum(const State& y) {

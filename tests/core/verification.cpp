@@ -2,10 +2,13 @@
 
 #include <doctest/doctest.h>
 
+#include <Eigen/Geometry>
+
 #include <cmath>
 
 #include "core/fixtures.hpp"
 #include "varia/core/galerkin.hpp"
+#include "varia/core/galerkin_chart.hpp"
 
 using namespace varia;
 using namespace varia::testing;
@@ -75,8 +78,8 @@ TEST_CASE("the symplecticity defect is at round-off for galerkin and large for e
   GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(2), {});
   ExplicitEuler euler;
   const double q = 1.0, p = 0.2;
-  const auto variational = symplecticity_defect(galerkin, &q, &p, 0.1);
-  const auto naive = symplecticity_defect(euler, &q, &p, 0.1);
+  const auto variational = symplecticity_defect(galerkin, space, &q, &p, 0.1);
+  const auto naive = symplecticity_defect(euler, space, &q, &p, 0.1);
   CAPTURE(variational.defect);
   CAPTURE(variational.noise);
   CAPTURE(naive.defect);
@@ -116,4 +119,43 @@ TEST_CASE("predictions follow the paper's theorems") {
   CHECK_FALSE(*predict(shooting).g_invariant);
   shooting.method_equivariant = true;
   CHECK(*predict(shooting).momentum_conserved);
+}
+
+namespace {
+
+// Lie-Euler for the free body, R1 = R0 exp(h Omega0), Pi1 = Pi0 + h Pi0 x Omega0: a Lie group
+// method that is not symplectic.
+struct LieEuler : DiscreteHamiltonianMap {
+  Eigen::Vector3d J{1, 2, 3};
+  int point_size() const override { return 9; }
+  int dim() const override { return 3; }
+  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override {
+    const Eigen::Vector3d Pi(p0[0], p0[1], p0[2]), Omega = Pi.cwiseQuotient(J);
+    so3::to_row_major(so3::from_row_major(q0) * so3::exp(Eigen::Vector3d(h * Omega)), q1);
+    Eigen::Map<Eigen::Vector3d>{p1} = Pi + h * Pi.cross(Omega);
+  }
+  const SolverStatistics& solver_statistics() const override { return statistics; }
+  const EvaluationCounters& evaluations() const override { return counters; }
+  SolverStatistics statistics;
+  EvaluationCounters counters;
+};
+
+}  // namespace
+
+TEST_CASE("on SO(3), in canonical chart coordinates: the galerkin map is symplectic, Lie-Euler is not") {
+  Rotations group;
+  Top body(Eigen::Vector3d(1, 2, 3), 0.0, Eigen::Vector3d::Zero());
+  auto rule = lobatto3();
+  LieGroupGalerkinDiscreteLagrangian galerkin(group, body, rule, equispaced_control_times(2), {});
+  LieEuler euler;
+  double R[9];
+  so3::to_row_major(so3::exp(Eigen::Vector3d(0.1, 0.2, 0.3)), R);
+  const double Pi[3] = {0.4, 1.6, -1.8};
+  const auto variational = symplecticity_defect(galerkin, group, R, Pi, 0.1);
+  const auto naive = symplecticity_defect(euler, group, R, Pi, 0.1);
+  CAPTURE(variational.defect);
+  CAPTURE(variational.noise);
+  CAPTURE(naive.defect);
+  CHECK(variational.defect < 1e-9);
+  CHECK(naive.defect > 1e-3);
 }

@@ -65,6 +65,9 @@ const std::map<std::string, std::string> kBadScenes{
     // inconsistent: both, neither, sizes, states
     {"momentum-without-symmetry.json", "/observe: expected no \"momentum\""},
     {"p-and-v.json", "/initial/p: not allowed here"},
+    {"reduced-heavy-top.json", "/method/reduced: the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group"},
+    {"reduced-on-rn.json", "/method/reduced: the reduced (Euler-Poincare) form is for Lie groups"},
+    {"reduced-with-shooting.json", "/method/reduced: not allowed here"},
     {"so3-not-orthogonal.json", "/initial/q: expected a point of SO3: R is not orthogonal"},
     {"so3-q-size.json", "/initial/q: expected 9 numbers"},
     {"so3-reflection.json", "/initial/q: expected a point of SO3: R is a reflection, not a rotation"},

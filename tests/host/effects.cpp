@@ -3,6 +3,8 @@
 // plugins the scene does not name cost a run nothing.
 #include <doctest/doctest.h>
 
+#include <cmath>
+
 #include <nlohmann/json.hpp>
 
 #include "support.hpp"
@@ -68,5 +70,17 @@ TEST_CASE("a composite's bad term is named by its pointer; forces on a construct
   write_file(dir / "forces-one-step.json", scene.dump());
   const Outcome forces = run_varia("run '" + (dir / "forces-one-step.json").string() + "'");
   CHECK(forces.code == 2);
-  check_one_error_line(forces, "/system/forces: forces are taken by construction 'galerkin' only");
+  check_one_error_line(forces, "/system/forces: forces are taken by constructions 'galerkin' and 'shooting' only");
+}
+
+TEST_CASE("a shooting scene with forces runs them through the construction and agrees with the galerkin one") {
+  const Json shooting = run_record("scenes/effects/damped-driven-shooting.json");
+  CHECK(shooting["plugins_loaded"] == Json{"Rn", "harmonic-oscillator", "damping", "periodic-force", "simpson", "rk4"});
+  CHECK(shooting["evaluations"]["force"].get<long>() > 0);
+  const Json galerkin = run_record("scenes/effects/damped-driven-oscillator.json");
+  for (const std::string part : {"q", "p"}) {
+    const double a = shooting["final"][part][0], b = galerkin["final"][part][0];
+    MESSAGE(part << "(50), shooting (rk4 + simpson) and galerkin (degree 2): " << a << ", " << b);
+    CHECK(std::abs(a - b) < 1e-6);
+  }
 }

@@ -158,3 +158,47 @@ TEST_CASE("verify exits 1 naming the properties a plugin falsely declares (Euler
   for (const char* property : {"self_adjoint", "ld_order", "global_order"})
     CHECK(varia::test::contains(outcome.err, property));
 }
+
+TEST_CASE("shooting with crouch-grossman on SO(3) (scenes/paper/rigid-body-shooting-cg.json): predicted and "
+          "measured not self-adjoint, G-invariant, momentum-conserving, order 2") {
+  Verified cg(json::parse(varia::test::read_file(varia::test::kSourceDir / "scenes/paper/rigid-body-shooting-cg.json")));
+  for (const char* name : {"self_adjoint", "g_invariant", "momentum_conserved", "global_order"}) {
+    const PropertyCheck& c = cg[name];
+    const std::string holds = c.holds ? (*c.holds ? "true" : "false") : "not measured";
+    MESSAGE(std::string(name) << ": predicted " << c.predicted.dump() << ", measured "
+                              << (c.measured ? *c.measured : -1.0) << ", holds " << holds << " (" << c.note << ")");
+  }
+  CHECK(cg["self_adjoint"].predicted == false);
+  CHECK(cg["self_adjoint"].holds == false);
+  CHECK(cg["g_invariant"].predicted == true);
+  CHECK(cg["g_invariant"].holds == true);
+  CHECK(cg["momentum_conserved"].predicted == true);
+  CHECK(cg["momentum_conserved"].holds == true);
+  CHECK(*cg["global_order"].measured == doctest::Approx(2).epsilon(0.1));
+}
+
+TEST_CASE("galerkin on SO(3) in the natural chart (scenes/paper/*-galerkin-*.json): G-invariant, momentum-conserving, "
+          "of order 2s in L_d and globally") {
+  for (std::string file : {"rigid-body-galerkin-s2.json", "heavy-top-galerkin-s2.json", "rigid-body-galerkin-reduced.json"}) {
+    CAPTURE(file);
+    Verified v(json::parse(varia::test::read_file(varia::test::kSourceDir / "scenes/paper" / file)));
+    for (const auto& c : v.checks)
+      MESSAGE(file << " " << c.name << ": predicted " << c.predicted.dump() << ", measured "
+                   << (c.measured ? *c.measured : -1.0) << " (" << c.note << ")");
+    for (const auto& c : v.checks) CHECK_FALSE(c.failed());
+    for (const char* name : {"g_invariant", "momentum_conserved", "energy_bounded"}) {
+      CAPTURE(name);
+      CHECK(v[name].predicted == true);
+      CHECK(v[name].holds == true);
+    }
+    const int order = v.scene.degree * 2;
+    for (const char* name : {"ld_order", "global_order"}) {
+      CAPTURE(name);
+      CHECK(v[name].predicted == order);
+      REQUIRE(v[name].measured);
+      CHECK(*v[name].measured >= order - 0.3);
+    }
+    // The natural chart at q0 is not symmetric in (q0, q1): no self-adjointness prediction.
+    CHECK(v["self_adjoint"].predicted.is_null());
+  }
+}

@@ -73,6 +73,8 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // The interpolant at quadrature node i: q_, v_.
   void interpolate(int i, double h);
   void add_forces(int i, double h, Order order);
+  // The dense Hessian's terms of node i with weight b (see action()).
+  void add_hessian(int i, double h, double b);
   // dq_i/dq^nu = l_nu(c_i), dv_i/dq^nu = l'_nu(c_i)/h: the weight of an entry's row or column.
   double weight(int i, int nu, bool by_v, double h) const;
   // Adds w * values[k] times the row and column weights to d(equation nu)/dq^mu of every block of
@@ -88,11 +90,16 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void solve_sparse();
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
+  void gradient_after_update(double h, int first_unknown, int size, bool forced);
   void warm_start(const double* q0, const double* p0, double h);
   // Degree 1 with nodes only at 0 and 1 and a constant mass matrix M: the IDEL equations are
-  // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton.
+  // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton. The step is compiled
+  // for N = n (fixed-size arithmetic) when n <= 4, for Eigen::Dynamic otherwise, and chosen once.
   bool explicit_form_applies(Quadrature& quadrature);
+  template <int N>
   void explicit_step(const double* q0, const double* p0, double h, double* q1, double* p1);
+  using StepFunction = void (GalerkinDiscreteLagrangian::*)(const double*, const double*, double,
+                                                            double*, double*);
 
   LagrangianEvaluator lagrangian_;
   Forces forces_;
@@ -105,10 +112,22 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   SolverStatistics statistics_;
   int n_, s_;
   // Workspace, sized once: a step allocates nothing.
-  Eigen::MatrixXd points_;    // n x (s+1), control points as columns
-  Eigen::MatrixXd previous_;  // the last step's control points
+  // The control points are held as offsets from q^0 = origin_: q^nu = origin_ + points_.col(nu).
+  // The interpolant's velocity (1/h) sum_nu l'_nu q^nu = (1/h) sum_nu l'_nu points_.col(nu)
+  // (sum_nu l'_nu = 0) is then formed from numbers of size h |v|, not |q|: its rounding error is
+  // eps |v|, not eps |q|/h, which would random-walk the momentum (docs/hard-cases.md, Kepler).
+  Eigen::VectorXd origin_;
+  Eigen::MatrixXd points_;    // n x (s+1), offsets of the control points as columns
+  Eigen::MatrixXd previous_;  // the last step's offsets
+  Eigen::VectorXd previous_end_;  // the last step's q1
   double previous_h_ = 0.0;
   bool has_previous_ = false;
+  // Compensated (Kahan) sums q1 = q0 + (q^s - q^0), p1 = p0 + (p1 - p0) across steps
+  // (compensated.hpp): the running compensations, the last p1 (with previous_end_, the state they
+  // belong to), and impulse_ = h sum_i b_i (L_q + f)(c_i) (see action()).
+  Eigen::VectorXd carry_q_, carry_p_, end_p_, impulse_;
+  Eigen::VectorXd change_;  // the gradient's change by a Newton update, (s+1) n
+  Eigen::VectorXd column_;  // add_hessian's two columns, 2n
   Eigen::VectorXd q_, v_, grad_, gradient_, residual_, update_, velocity_;
   Eigen::MatrixXd hess_, hessian_, jacobian_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
@@ -131,12 +150,11 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
     bool analyzed = false;
   };
   SparseJacobian sparse_;
-  // The explicit form: endpoint weights, the factorized mass matrix, and dL/dq at the last q1
-  // (reused as dL/dq at the next q0: one gradient evaluation per step).
-  bool explicit_ = false;
+  // The explicit form: its step (null when it does not apply), endpoint weights, M and M^{-1},
+  // and dL/dq at the last q1 (reused as dL/dq at the next q0: one gradient evaluation per step).
+  StepFunction explicit_step_ = nullptr;
   double b0_ = 0.0, b1_ = 0.0;
-  Eigen::MatrixXd mass_matrix_;
-  Eigen::LLT<Eigen::MatrixXd> mass_;
+  Eigen::MatrixXd mass_matrix_, inverse_mass_;
   Eigen::VectorXd force_, last_q_;
   bool has_force_ = false;
 };

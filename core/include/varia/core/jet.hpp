@@ -121,6 +121,13 @@ inline Jet2 sqrt(const Jet2& a) {
   const double s = std::sqrt(a.value);
   return jet::unary(a, s, 0.5 / s, -0.25 / (s * a.value));
 }
+// atan2(y, x): F_y = x/r2, F_x = -y/r2, F_yy = -2xy/r2^2 = -F_xx, F_xy = (y^2 - x^2)/r2^2.
+inline Jet2 atan2(const Jet2& y, const Jet2& x) {
+  const double r2 = x.value * x.value + y.value * y.value, r4 = r2 * r2;
+  const double cross = 2 * x.value * y.value / r4;
+  return jet::binary(y, x, std::atan2(y.value, x.value),
+                     {x.value / r2, -y.value / r2, -cross, (y.value * y.value - x.value * x.value) / r4, cross});
+}
 inline Jet2 abs(const Jet2& a) { return a.value < 0 ? -a : a; }
 // a^b; with a constant exponent only the a-derivatives enter (a may then be negative).
 inline Jet2 pow(const Jet2& a, const Jet2& b) {

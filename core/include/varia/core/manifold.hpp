@@ -4,6 +4,7 @@
 // vectors, velocities and momenta are dim() numbers, left-trivialized on a Lie group.
 #pragma once
 
+#include "varia/core/jet.hpp"
 #include "varia/core/plugin_object.hpp"
 
 namespace varia {
@@ -23,6 +24,22 @@ class Manifold : public PluginObject {
   // How far q lies off the manifold in its embedding, for the run's drift observables:
   // ||I - R^T R||_F on SO(3) (the paper's orthogonality error); 0 where every point is valid.
   virtual double constraint_error(const double* /*q*/) const noexcept { return 0.0; }
+  // The natural chart to second order, for the Galerkin construction on a Lie group (paper,
+  // sec. 2, "Natural charts"): with n = dim(),
+  //   point:    q0 exp(eta) exp(xi) at eta = 0, point_size() jets in the 2n variables (eta, xi);
+  //   velocity: the left-trivialized velocity dexp_{-xi}(xi_dot) of the curve q0 exp(xi(t)) with
+  //             xi' = xi_dot, n jets in the 2n variables (xi, xi_dot).
+  // Either output may be null. On R^n: q0 + eta + xi and xi_dot. Needs 2n <= kMaxJetVariables.
+  virtual Status chart_jets(const double* /*q0*/, const double* /*xi*/, const double* /*xi_dot*/,
+                            Jet2* /*point*/, Jet2* /*velocity*/) noexcept {
+    return "this manifold does not provide its natural chart at jets";
+  }
+  // The chart's inverse at jets, for the shooting construction's boundary condition (paper,
+  // sec. 3 with sec. 2 "Natural charts"): xi = local(q0, q) = log(q0^{-1} q) (dim() jets) of a
+  // point q given as point_size() jets; q0 is a constant. On R^n: q - q0.
+  virtual Status local_jets(const double* /*q0*/, const Jet2* /*q*/, Jet2* /*xi*/) noexcept {
+    return "this manifold does not provide its natural chart's inverse at jets";
+  }
 };
 
 }  // namespace varia

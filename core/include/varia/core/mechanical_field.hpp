@@ -4,6 +4,9 @@
 //   cotangent form (q, p):  q' = M^{-1} p, p' = dL/dq (q, M^{-1} p)   (Hamilton's equations of
 //                           the Legendre transform H(q, p) = <p, v> - L(q, v), v = M^{-1} p,
 //                           paper, sec. 3 "Generalizations").
+// With forces f(t, q, v) (force.hpp) the field is that of the forced Euler-Lagrange equations,
+// d/dt dL/dv - dL/dq = f (Marsden & West 2001, sec. 3.2): M v' = L_q + f, or p' = L_q + f; the
+// time is then the state's last number, t' = 1 (the methods integrate autonomous fields).
 // The acceleration comes from L's exact derivatives, at doubles and at jets. The field also
 // drives one step of a one-step plugin, turning its Status into the right exception.
 #pragma once
@@ -14,6 +17,7 @@
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/force.hpp"
 #include "varia/core/manifold.hpp"
 #include "varia/core/mechanics.hpp"
 #include "varia/core/one_step.hpp"
@@ -75,12 +79,13 @@ class EulerLagrangeField : public VectorField {
   std::string message_;
 };
 
-// On R^n: y = (q, v) or (q, p), N = 2n.
+// On R^n: y = (q, v) or (q, p), N = 2n; with forces y = (q, v, t) or (q, p, t), N = 2n + 1.
 class MechanicalField final : public EulerLagrangeField {
  public:
-  // Throws std::invalid_argument unless the Lagrangian declares a constant mass matrix.
-  MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space);
-  int size() const noexcept override { return 2 * n_; }
+  // Throws std::invalid_argument unless the Lagrangian declares a constant mass matrix. The forces
+  // (may be null or empty: none) are applied while forced() is on.
+  MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space, Forces* forces = nullptr);
+  int size() const noexcept override { return 2 * n_ + (clock() ? 1 : 0); }
   Status eval(const double* y, double* f) noexcept override;
   Status eval(const Jet2* y, Jet2* f) noexcept override;
   Status jacobian(const double* y, double* f, double* df) noexcept override;
@@ -88,8 +93,25 @@ class MechanicalField final : public EulerLagrangeField {
   // The velocity of a state's second half: v = w (tangent) or M^{-1} w (cotangent).
   void velocity(const Jet2* w, Jet2* v) const;
 
+  // Whether the state carries the time (the field has forces), and whether they are applied.
+  bool clock() const { return forces_ != nullptr; }
+  void set_forced(bool forced) { forced_ = forced && clock(); }
+  // f(t, y[2n], q, v) at jets q = y, v = velocity(y + n): the value, and the derivatives through
+  // the forces' Jacobian, f_x = f_q q_x + f_v v_x, f_xx = f_q q_xx + f_v v_xx. The Force interface
+  // gives no second derivatives of f: the Hessian part is exact for forces affine in (q, v), as
+  // every bundled force is (damping, periodic-force).
+  void force(const Jet2* y, const Jet2* v, Jet2* f);
+
  private:
+  // Adds the forces at the values of y (velocity v_) to gradient_.head(n) (= L_q + f), and with
+  // `jacobian` their Jacobian to the rows of hessian_ (d(L_q + f)/d(q, v)).
+  void add_forces(const double* y, bool jacobian);
+
   PhaseSpace space_;
+  Forces* forces_;
+  bool forced_ = false;
+  Eigen::VectorXd force_, force_jacobian_, position_;
+  std::vector<Jet2> force_jet_;
   // Workspace, sized once.
   Eigen::VectorXd v_, gradient_;
   Eigen::MatrixXd hessian_;

@@ -26,16 +26,46 @@
 // prolongation of the Euler-Lagrange vector field (paper, sec. 3 "More general quadrature
 // formulas").
 //
-// Restrictions: a vector-space manifold of dimension n <= 4 (jets of 2n <= 8 variables) and a
-// Lagrangian with a constant mass matrix (mechanical_field.hpp).
+// Forces (force.hpp) enter the step by the discrete Lagrange-d'Alembert principle (Marsden &
+// West 2001, sec. 3.2): p0 = -D1 L_d - f_d^-, p1 = D2 L_d + f_d^+, the discrete forces through
+// the same quadrature as L_d along the same propagation,
+//   f_d^- = h sum_i b_i (dq^i/dq0)^T f(t + c_i h, q^i, v^i),   f_d^+ = h sum_i b_i (dq^i/dq1)^T f_i,
+// the derivatives taken at fixed q1 and q0 through w0(q0, q1) like lambda. With the virtual work
+// W = h sum_i b_i <f_i, q^i(x)> (f_i frozen), f_d^- and f_d^+ are W's D1 and D2 by the formulas
+// above: alpha = G_x + W_x takes G_x's place, and Phi gains dW_x/dx (f_i no longer frozen):
+//   dW_x/dx = h sum_i b_i (sum_r f_ir q^i_r,xx + q^i_x^T f_i,x).
+// The propagation is that of the FORCED Euler-Lagrange equations, M v' = L_q + f (mechanical_
+// field.hpp). Marsden & West's exact discrete Lagrangian and exact discrete forces (sec. 3.2)
+// integrate along the forced solution between q0 and q1, and only along it does the first
+// variation, d/dq1 int L + int <f, dq/dq1> = p(h) + int <EL + f, dq/dq1>, reduce to p(h): with the
+// unforced flow the construction is of order 2 whatever Psi and the rule (the free particle with
+// f = -c v: the unforced flow is the straight line, and the step becomes the Galerkin degree-1
+// map p1 = p0 (1 - ch/2)/(1 + ch/2) for every exact Psi and rule). Forces are applied in step()
+// only; evaluate() (varia ld) gives the unforced L_d. The time is set by set_time and advanced
+// by h per step. Not with the type-2 form nor with end-derivative quadratures.
+//
+// On a Lie group (a manifold that is not a vector space; SO(3)-shaped, rotation_field.hpp) the same
+// construction runs in the natural charts (paper, sec. 2 "Natural charts", sec. 3): the jet
+// variables are x = (eta, w0) with q^0 = q0 exp(eta) at eta = 0 (Manifold::chart_jets), the state
+// (R, Omega) propagated by the method with the Euler-Lagrange field on TSO(3) (a Lie group method
+// moves R exp(.)), S = h sum_i b_i L(R^i, Omega^i), and the boundary quantity B = local(q1, R^n)
+// = log(q1^{-1} R^n) (Manifold::local_jets), centred at R^n's value in a step. Then G_eta - B_eta^T
+// lambda is D1 L_d and lambda = dG/dB at B = 0 is D2 L_d, both left-trivialized: the discrete
+// momenta are body momenta, as lie-verlet's. The lagrangian form only, no forces, no end-derivative
+// quadratures there.
+//
+// Restrictions: a manifold of dimension n <= 4 (jets of 2n <= 8 variables) and a Lagrangian with
+// a constant mass matrix (mechanical_field.hpp).
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <memory>
 #include <string>
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/force.hpp"
 #include "varia/core/manifold.hpp"
 #include "varia/core/mechanical_field.hpp"
 #include "varia/core/mechanics.hpp"
@@ -53,9 +83,10 @@ ShootingForm shooting_form(const std::string& name);
 class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHamiltonianMap {
  public:
   // The method's stage solves use options too. Throws std::invalid_argument for an unsupported
-  // manifold, Lagrangian or quadrature.
+  // manifold, Lagrangian or quadrature, or forces with the type_2 form or an end-derivative rule.
   ShootingDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian, Quadrature& quadrature,
-                             OneStepMethod& method, ShootingForm form, SolverOptions options);
+                             OneStepMethod& method, ShootingForm form, SolverOptions options,
+                             std::vector<Force*> forces = {});
 
   // L_d(q0, q1), D1 L_d, D2 L_d (any output may be null): the boundary-value problem
   // q^n(q0, w0) = q1 solved for w0 by Newton's method. In the type_2 form, L_d is the Legendre
@@ -63,14 +94,15 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // D1 L_d = -D1 H_d^+ and D2 L_d = p1.
   void evaluate(const double* q0, const double* q1, double h, double* Ld, double* D1,
                 double* D2) override;
-  int point_size() const override { return n_; }
+  int point_size() const override { return m_; }
   int dim() const override { return n_; }
   void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
   // The shooting Newton iteration (one solve per step or evaluation).
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   // The one-step method's stage solves (zeros for explicit methods).
   const SolverStatistics& stage_statistics() const { return stages_; }
-  const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
+  const EvaluationCounters& evaluations() const override;
+  void set_time(double t) override { t_ = t; }
   // Residual norms of the last shooting solve, one per iteration (quadratic convergence).
   const std::vector<double>& last_residuals() const { return residuals_; }
 
@@ -81,27 +113,40 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
     boundary,   // B - q1: evaluate in a Type I form
     lambda,     // lambda - q1: evaluate in the type_2 form
   };
+  void start_point(const double* q0);
+  void boundary();
   void shoot(const double* q0, const double* w0, double h);
   void accumulate(int node, double h, Jet2& S);
+  void add_work(double weight);
   void differentiate();
   void residual(Target target, const double* data);
   void solve(const double* q0, double h, Target target, const double* data);
   bool type_2() const { return form_ == ShootingForm::type_2; }
 
+  Manifold& manifold_;
   LagrangianEvaluator lagrangian_;
-  MechanicalField field_;
+  Forces forces_;
+  std::unique_ptr<EulerLagrangeField> field_;
+  MechanicalField* mechanical_;  // field_ on a vector space, else null
   OneStepMethod& method_;
   ShootingForm form_;
   SolverOptions options_;
-  int n_;
+  int m_, n_;  // point_size, dim
   std::vector<double> nodes_, weights_;  // with 0 and 1 included
   double start_correction_ = 0.0, end_correction_ = 0.0;  // a_1, z_1 (Euler-Maclaurin)
+  double t_ = 0.0;       // the time at the start of the next step
+  bool forced_ = false;  // forces applied in the current solve (steps of a forced system)
+  bool target_is_end_ = false;  // B's chart at q^n's value (a step) or at target_ (evaluate)
+  std::vector<double> target_, zero_ = std::vector<double>(kMaxJetVariables, 0.0);
   SolverStatistics statistics_, stages_;
+  mutable EvaluationCounters counters_;
   std::vector<double> residuals_;
   // Workspace, sized once: a step allocates nothing.
-  std::vector<Jet2> state_, next_, v_, acceleration_, gradient_, boundary_;
+  std::vector<Jet2> state_, next_, v_, acceleration_, gradient_, boundary_, force_;
   Jet2 generating_;
   Eigen::VectorXd w_, lambda_, D1_, residual_, update_;
+  Eigen::VectorXd alpha_;        // G_x + W_x: the forced 1-form in x = (q0, w0)
+  Eigen::MatrixXd work_jacobian_;  // dW_x/dx
   Eigen::MatrixXd Bq_, Bw_, phi_, jacobian_;
   Eigen::PartialPivLU<Eigen::MatrixXd> BwT_lu_, jacobian_lu_;  // of B_w^T and the Jacobian
 };

@@ -121,11 +121,27 @@ Vector3<T> axial(const Matrix3<T>& R) {
   return vee(Matrix3<T>(R - R.transpose())) / 2.0;
 }
 
+// The unit axis n of a rotation R by theta with cos theta = cosine < 0, from the symmetric part
+// R + R^T = 2 cos theta I + 2 (1 - cos theta) n n^T (its largest diagonal entry), with the sign of
+// the axial vector s = sin(theta) n: near pi, s has lost its digits but not its sign.
+template <class T>
+Vector3<T> axis_past_half_turn(const Matrix3<T>& R, const T& cosine, const Vector3<T>& s) {
+  using std::sqrt;
+  const Matrix3<T> nn = (R + R.transpose() - 2.0 * cosine * Matrix3<T>::Identity()) /
+                        (2.0 * (1.0 - cosine));
+  int k = 0;
+  for (int i = 1; i < 3; ++i)
+    if (real(nn(i, i)) > real(nn(k, k))) k = i;
+  Vector3<T> n = nn.col(k) / sqrt(nn(k, k));
+  if (real(n.dot(s)) < 0.0) n = -n;
+  return n;
+}
+
 // log R, the w with |w| <= pi and exp(hat(w)) = R. With s = sin(theta) n from axial(R) and
 // cos theta = (tr R - 1)/2: w = (theta / sin theta) s, theta = atan2(|s|, cos theta), accurate at
 // every angle, and summed as the series of asin(y)/y in y^2 = |s|^2 near theta = 0. Near pi
 // (cos theta < 0) s loses its digits, and the axis n comes from the symmetric part
-// R + R^T = 2 cos theta I + 2 (1 - cos theta) n n^T, its sign from s.
+// (axis_past_half_turn).
 template <class T>
 Vector3<T> log(const Matrix3<T>& R) {
   using std::atan2;
@@ -139,14 +155,7 @@ Vector3<T> log(const Matrix3<T>& R) {
     const T sine = sqrt(sine2);
     return (atan2(sine, cosine) / sine) * s;
   }
-  const Matrix3<T> nn = (R + R.transpose() - 2.0 * cosine * Matrix3<T>::Identity()) /
-                        (2.0 * (1.0 - cosine));
-  int k = 0;
-  for (int i = 1; i < 3; ++i)
-    if (real(nn(i, i)) > real(nn(k, k))) k = i;
-  Vector3<T> n = nn.col(k) / sqrt(nn(k, k));
-  if (real(n.dot(s)) < 0.0) n = -n;
-  return atan2(sqrt(sine2), cosine) * n;
+  return atan2(sqrt(sine2), cosine) * axis_past_half_turn(R, cosine, s);
 }
 
 // dexp_w = sum_n ad_w^n/(n+1)! = I + cosc hat(w) + sinc3 hat(w)^2 (paper, sec. 2: T_w exp =
@@ -180,10 +189,17 @@ Matrix3<T> cayley(const Vector3<T>& f) {
   return Matrix3<T>::Identity() + cayley_minus_identity(f);
 }
 
-// cay^{-1}(F) = vee(F - F^T)/(1 + tr F), for rotations by less than pi.
+// cay^{-1}(F) = tan(theta/2) n for the rotation F by theta < pi about n: vee(F - F^T)/(1 + tr F)
+// = sin(theta) n / (2 (1 + cos theta)). Past a half turn (cos theta < 0) 1 + tr F loses its digits
+// (it is (pi - theta)^2 near pi, where the result's own condition is 1/(pi - theta)), and
+// tan(theta/2) = (1 - cos theta)/sin theta with n from the symmetric part is used instead.
 template <class T>
 Vector3<T> cayley_inverse(const Matrix3<T>& F) {
-  return vee(Matrix3<T>(F - F.transpose())) / (1.0 + F.trace());
+  using std::sqrt;
+  const Vector3<T> s = axial(F);
+  const T cosine = (F.trace() - 1.0) / 2.0;
+  if (real(cosine) >= 0.0) return s / (1.0 + cosine);
+  return ((1.0 - cosine) / sqrt(s.squaredNorm())) * axis_past_half_turn(F, cosine, s);
 }
 
 // The left-trivialized gradient at R of a function with embedding gradient G = df/dR:
@@ -198,6 +214,35 @@ Vector3<T> trivialize(const Matrix3<T>& R, const Matrix3<T>& G) {
 template <class T>
 T orthogonality_error(const Matrix3<T>& R) {
   return (Matrix3<T>::Identity() - R.transpose() * R).norm();
+}
+
+// The natural chart at R0 to second order (Manifold::chart_jets; paper, sec. 2 "Natural charts"):
+// R0 exp(eta) exp(xi) at eta = 0 as 9 row-major jets in the variables (eta, xi), and the
+// left-trivialized velocity dexp_{-xi}(xi_dot) as 3 jets in (xi, xi_dot). Either output may be
+// null. Jet is a second-order jet type with Jet::variable(value, count, index) (jet.hpp).
+template <class Jet>
+void chart_jets(const double* R0, const double* xi, const double* xi_dot, Jet* point, Jet* velocity) {
+  if (point != nullptr) {
+    Vector3<Jet> eta, w;
+    for (int k = 0; k < 3; ++k) {
+      eta(k) = Jet::variable(0.0, 6, k);
+      w(k) = Jet::variable(xi[k], 6, 3 + k);
+    }
+    const Matrix3<Jet> base = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R0)
+                                  .template cast<Jet>();
+    const Matrix3<Jet> R = base * exp(eta) * exp(w);
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) point[3 * r + c] = R(r, c);
+  }
+  if (velocity != nullptr) {
+    Vector3<Jet> w, rate;
+    for (int k = 0; k < 3; ++k) {
+      w(k) = Jet::variable(xi[k], 6, k);
+      rate(k) = Jet::variable(xi_dot[k], 6, 3 + k);
+    }
+    const Vector3<Jet> omega = dexp(Vector3<Jet>(-w)) * rate;
+    for (int k = 0; k < 3; ++k) velocity[k] = omega(k);
+  }
 }
 
 // Row-major 9-number buffers <-> matrices (the spec's layout of a point).

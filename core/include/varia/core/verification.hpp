@@ -22,6 +22,7 @@ struct Composition {
   bool quadrature_symmetric = false;
   int degree = 0;                      // Galerkin interpolation degree s
   bool control_times_symmetric = false;
+  bool natural_chart = false;          // Galerkin on a Lie group: interpolation in the chart at q0
   int method_order = 0;                // one-step method order p
   bool method_self_adjoint = false;
   bool method_symplectic = false;      // declared by one-step plugins
@@ -37,7 +38,9 @@ struct Predictions {
 };
 
 // Galerkin (paper, sec. 2): order min(2s, quadrature order); self-adjoint for a symmetric rule and
-// symmetric control times; G-invariant for an invariant L (equivariant natural-chart interpolant).
+// symmetric control times on a vector space (the chart at q0 of a Lie group is not symmetric in
+// q0 and q1: no prediction there); G-invariant for an invariant L (equivariant natural-chart
+// interpolant).
 // Shooting (paper, sec. 3 theorem): order min(p, q); self-adjoint for a self-adjoint method and a
 // symmetric rule; G-invariant for a G-equivariant method and an invariant L.
 Predictions predict(const Composition& composition);
@@ -79,15 +82,16 @@ using Observer = std::function<void(long, const double*, const double*)>;
 void run(DiscreteHamiltonianMap& map, std::vector<double> q, std::vector<double> p, double h,
          long steps, const Observer& observe);
 
-// The one-step map's Jacobian M = d(q1, p1)/d(q0, p0) on a vector space, by central differences
-// with Richardson extrapolation (test of a property, not inside any solve), and its symplecticity
-// defect ||M^T J M - J||_max. `noise` is the change of the defect between two difference steps:
-// the floor below which the defect means nothing.
+// The one-step map's Jacobian M = d(xi1, pi1)/d(xi0, pi0) in canonical coordinates of T*Q (the
+// natural chart at q0 and its conjugate momenta pi = dexp_{-xi}^T p; (q, p) on a vector space), by
+// central differences with Richardson extrapolation (test of a property, not inside any solve),
+// and its symplecticity defect ||M^T J M - J||_max. `noise` is the change of the defect between
+// two difference steps: the floor below which the defect means nothing.
 struct SymplecticityDefect {
   double defect = 0.0, noise = 0.0;
 };
-SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, const double* q0,
-                                         const double* p0, double h);
+SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& manifold,
+                                         const double* q0, const double* p0, double h);
 
 // Whether the energy error drifts: the largest error over the last quarter of the run against
 // the largest over the first quarter (a bounded error gives a ratio near 1, a drift about 3 or

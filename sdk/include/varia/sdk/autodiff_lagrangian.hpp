@@ -8,7 +8,7 @@
 // sizes m + n = 2, 4, 6, 12 (Rn of dim 1, 2, 3; SO3) they have a fixed size, so the arithmetic
 // is unrolled and a second-order scalar holds (k+1)^2 doubles instead of 17^2. The same model,
 // evaluated at a dual number over second-order jets, gives gradient_jet (at most
-// kMaxJetVariables position and velocity numbers together).
+// kMaxJetInputs = 12 position and velocity numbers together: SO(3)'s 9 + 3).
 #pragma once
 
 #include <Eigen/Core>
@@ -31,10 +31,11 @@ template <int K>
 using FixedDual = Eigen::AutoDiffScalar<Eigen::Matrix<double, K, 1>>;
 template <int K>
 using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
-// First derivatives at jet inputs (Lagrangian::gradient_jet): at most kMaxJetVariables numbers
-// m + n, which keeps a Vec of these scalars within Eigen's stack allocation limit.
-using JetDual = Eigen::AutoDiffScalar<
-    Eigen::Matrix<Jet2, Eigen::Dynamic, 1, 0, kMaxJetVariables, 1>>;
+// First derivatives at jet inputs (Lagrangian::gradient_jet): at most kMaxJetInputs numbers
+// m + n (SO(3): 9 + 3), which keeps a Vec of these scalars (16 x 7.9 kB) within Eigen's stack
+// allocation limit (128 kB).
+inline constexpr int kMaxJetInputs = 12;
+using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, Eigen::Dynamic, 1, 0, kMaxJetInputs, 1>>;
 
 template <class Model>
 class AutodiffLagrangian : public Lagrangian {
@@ -66,9 +67,9 @@ class AutodiffLagrangian : public Lagrangian {
   Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final {
     return guarded(error_, [&] {
       const int k = m_ + n_;
-      if (k > kMaxJetVariables)
+      if (k > kMaxJetInputs)
         throw std::invalid_argument("evaluation at jets takes at most " +
-                                    std::to_string(kMaxJetVariables) +
+                                    std::to_string(kMaxJetInputs) +
                                     " position and velocity numbers together");
       Vec<JetDual> qd(m_), vd(n_);
       for (int i = 0; i < k; ++i) {
@@ -104,14 +105,19 @@ class AutodiffLagrangian : public Lagrangian {
     }
   }
 
-  // L and its gradient by forward mode: one derivative direction per number of (q, v).
+  // L and its gradient by forward mode: one derivative direction per number of (q, v). For a
+  // fixed-size D the loop runs to the compile-time size, so that it unrolls and each seed
+  // e_i is stored whole (not a zero vector then one coefficient, which the next whole-vector
+  // load has to wait for).
   template <class D>
   void first_order(const double* q, const double* v, double* value, double* gradient) const {
-    const int k = m_ + n_;
+    constexpr int fixed = D::DerType::SizeAtCompileTime;
+    const int k = fixed > 0 ? fixed : m_ + n_;
     Vec<D> qd(m_), vd(n_);
     for (int i = 0; i < k; ++i) {
-      D z(at(q, v, i), k, i);
-      (i < m_ ? qd(i) : vd(i - m_)) = z;
+      D& z = i < m_ ? qd(i) : vd(i - m_);
+      z.value() = at(q, v, i);
+      z.derivatives() = D::DerType::Unit(k, i);
     }
     const D r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value();

@@ -1,0 +1,105 @@
+// The Galerkin discrete Lagrangian on a Lie group, in the natural chart (paper, sec. 2, "Natural
+// charts"): the degree-s Lagrange interpolant in the Lie algebra through the control points
+// xi^0 = 0, xi^1, ..., xi^s in the chart at g0, mapped to the group as g(t) = g0 exp(xi(t)), whose
+// left-trivialized velocity is dexp_{-xi}(xi') (so3.hpp on the sign):
+//   L_d(g0, g1) = ext_{xi^1..xi^{s-1}} h sum_i b_i L(g0 exp(xi(c_i h)), dexp_{-xi(c_i h)} xi'(c_i h)),
+//   xi^s = log(g0^{-1} g1).
+// The interpolant is G-equivariant (the paper's Proposition in "Natural charts"), so L_d is
+// G-invariant when L is, and the discrete Noether momentum is conserved.
+//
+// Left-trivialized derivatives. With S(eta, xi^1..xi^s) the action of the curve
+// g0 exp(eta) exp(xi(t)) (the chart based at g0 exp(eta)), sigma = dS/dxi^s and tau = dS/deta at
+// eta = 0, and the internal control points held fixed (envelope theorem: dS/dxi^nu = 0):
+//   D2 L_d = dexp_{-xi^s}^{-T} sigma   (g1 exp(e) = g0 exp(xi^s + dexp_{-xi^s}^{-1} e)),
+//   D1 L_d = tau - dexp_{xi^s}^{-T} sigma   (g1 fixed while g0 -> g0 exp(eta) moves xi^s by
+//                                           -dexp_{xi^s}^{-1} eta).
+// The discrete Hamiltonian map solves p0 = -D1 L_d with the internal conditions for xi^1..xi^s by
+// Newton's method with the exact Jacobian: the manifold gives its chart at second-order jets
+// (Manifold::chart_jets), the Lagrangian its dense Hessian, and the chain rule their product.
+//
+// Reduced form (sec. 2, "Higher-order discrete Euler-Poincare equations"), for a Lagrangian
+// invariant under the whole group (momentum_size() == dim()): L(g, Omega) = l(Omega), so tau = 0
+// and the action depends on the velocities alone. The step solves the higher-order discrete
+// Euler-Poincare equations dexp_{xi^s}^{-T} sigma = p0 (the right-trivialized l_d'(f) = p0,
+// f = exp(xi^s)) with the internal conditions, evaluating l(Omega) = L(g0, Omega) and no position
+// derivative, then reconstructs g1 = g0 f and p1 = dexp_{-xi^s}^{-T} sigma = Ad*_f p0.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+#include <vector>
+
+#include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/core/galerkin.hpp"
+#include "varia/core/jet.hpp"
+#include "varia/core/manifold.hpp"
+#include "varia/core/mechanics.hpp"
+#include "varia/core/quadrature.hpp"
+
+namespace varia {
+
+class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHamiltonianMap {
+ public:
+  // Throws std::invalid_argument when the manifold gives no chart at jets or the reduced form is
+  // asked of a Lagrangian not invariant under the whole group.
+  LieGroupGalerkinDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian,
+                                     Quadrature& quadrature, std::vector<double> control_times,
+                                     SolverOptions options, bool reduced = false);
+  int degree() const { return s_; }
+
+  void evaluate(const double* q0, const double* q1, double h, double* Ld, double* D1,
+                double* D2) override;
+  int point_size() const override { return m_; }
+  int dim() const override { return n_; }
+  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
+  const SolverStatistics& solver_statistics() const override { return statistics_; }
+  const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
+  // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).
+  const std::vector<double>& last_residuals() const { return residuals_; }
+
+ private:
+  // S and, in gradient_ and hessian_, its derivatives in (eta, xi^1, ..., xi^s) (blocks of n
+  // numbers; block 0 is eta) for the control points in xi_ and the base point q0.
+  double action(const double* q0, double h);
+  // Adds quadrature node i: L at the chart curve and the chain rule through the chart's jets.
+  double add_node(const double* q0, int i, double h);
+  // dexp_{sign w} (= d velocity / d xi_dot at xi = -sign w) into dexp_, its inverse transpose,
+  // and its derivatives in (sign w)_l (one n x n matrix each), from the manifold's chart at jets.
+  void dexp_with_derivatives(const double* q0, const double* w, double sign);
+  // The residual of the step's equations [p0 + D1 L_d; dS/dxi^1..s-1] (evaluate: internal only)
+  // and its Jacobian in the unknowns.
+  void step_equations(const double* p0);
+  void newton(const double* q0, const double* p0, double h);
+  void warm_start(const double* q0, const double* p0, double h);
+  void check(Status status) const;
+
+  Manifold& manifold_;
+  LagrangianEvaluator lagrangian_;
+  LagrangeBasis basis_;
+  Eigen::VectorXd weights_;
+  Eigen::MatrixXd extrapolation_;  // l_mu(1 + d_nu): the last step's curve continued
+  SolverOptions options_;
+  SolverStatistics statistics_;
+  bool reduced_;
+  int m_, n_, s_;
+  std::vector<double> residuals_;
+  // Workspace, sized once: a step allocates nothing.
+  Eigen::MatrixXd xi_;        // n x (s+1) control points in the chart, column 0 = 0
+  Eigen::MatrixXd previous_;  // the last step's control points
+  Eigen::VectorXd previous_base_, last_end_;  // the last step's g0 and g1
+  double previous_h_ = 0.0;
+  bool has_previous_ = false;
+  std::vector<Jet2> point_, velocity_;
+  Eigen::VectorXd node_xi_, node_rate_, q_, v_, grad_, node_gradient_;
+  Eigen::MatrixXd hess_, chain_, hess_chain_, node_hessian_;
+  Eigen::VectorXd gradient_;  // n (s+1)
+  Eigen::MatrixXd hessian_;   // n (s+1) square
+  Eigen::MatrixXd dexp_, dexp_inverse_T_;            // dexp_{w}, dexp_w^{-T}
+  std::vector<Eigen::MatrixXd> dexp_derivative_;     // d dexp_w / dw_l
+  Eigen::PartialPivLU<Eigen::MatrixXd> dexp_lu_, lu_;
+  Eigen::VectorXd residual_, update_, momentum_;
+  Eigen::MatrixXd jacobian_;
+  int unknowns_ = 0;  // the leading control points solved for: s (step) or s - 1 (evaluate)
+};
+
+}  // namespace varia
