@@ -83,7 +83,7 @@ void LieGroupGalerkinDiscreteLagrangian::check(Status status) const {
 //   dL/dy = Z^T dL/dz,   d2L/dy2 = Z^T (d2L/dz2) Z + sum_k dL/dz_k d2z_k/dy2,   Z = dz/dy,
 // carried to the unknowns (eta, xi^1..xi^s) by xi = sum_nu l_nu(c_i) xi^nu and
 // xi_dot = sum_nu l'_nu(c_i) xi^nu / h (paper, sec. 2: the interpolant in the Lie algebra).
-double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, double h) {
+double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, double h, bool with_hessian) {
   node_xi_.noalias() = xi_ * basis_.phi.row(i).transpose();
   node_rate_.noalias() = xi_ * basis_.dphi.row(i).transpose() / h;
   const int n = n_;
@@ -91,16 +91,19 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
                              reduced_ ? nullptr : point_.data(), velocity_.data()));
   for (int k = 0; k < m_; ++k) q_(k) = reduced_ ? q0[k] : point_[k].value;  // reduced: l = L(g0, .)
   for (int k = 0; k < n; ++k) v_(k) = velocity_[k].value;
-  const double L = lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data());
+  const double L = with_hessian ? lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data())
+                                : lagrangian_.gradient(q_.data(), v_.data(), grad_.data());
   if (!reduced_)
     for (int k = 0; k < m_; ++k) chain_.row(k).head(2 * n) = point_[k].gradient.transpose();
   for (int k = 0; k < n; ++k) chain_.row(m_ + k).tail(2 * n) = velocity_[k].gradient.transpose();
   node_gradient_.noalias() = chain_.transpose() * grad_;
-  hess_chain_.noalias() = hess_ * chain_;
-  node_hessian_.noalias() = chain_.transpose() * hess_chain_;
-  if (!reduced_)
-    for (int k = 0; k < m_; ++k) node_hessian_.topLeftCorner(2 * n, 2 * n) += grad_(k) * point_[k].hessian;
-  for (int k = 0; k < n; ++k) node_hessian_.bottomRightCorner(2 * n, 2 * n) += grad_(m_ + k) * velocity_[k].hessian;
+  if (with_hessian) {
+    hess_chain_.noalias() = hess_ * chain_;
+    node_hessian_.noalias() = chain_.transpose() * hess_chain_;
+    if (!reduced_)
+      for (int k = 0; k < m_; ++k) node_hessian_.topLeftCorner(2 * n, 2 * n) += grad_(k) * point_[k].hessian;
+    for (int k = 0; k < n; ++k) node_hessian_.bottomRightCorner(2 * n, 2 * n) += grad_(m_ + k) * velocity_[k].hessian;
+  }
 
   // The weight of node block a (0 eta, 1 xi, 2 xi_dot) in the action's block beta (0 eta, nu >= 1
   // the control point xi^nu; xi^0 = 0 is fixed).
@@ -114,6 +117,7 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
       const double ca = c(a, beta);
       if (ca == 0.0) continue;
       gradient_.segment(beta * n, n) += w * ca * node_gradient_.segment(a * n, n);
+      if (!with_hessian) continue;
       for (int gamma = 0; gamma <= s_; ++gamma)
         for (int b = 0; b < 3; ++b) {
           const double cb = c(b, gamma);
@@ -124,11 +128,11 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
   return w * L;
 }
 
-double LieGroupGalerkinDiscreteLagrangian::action(const double* q0, double h) {
+double LieGroupGalerkinDiscreteLagrangian::action(const double* q0, double h, bool with_hessian) {
   gradient_.setZero();
-  hessian_.setZero();
+  if (with_hessian) hessian_.setZero();
   double S = 0.0;
-  for (int i = 0; i < weights_.size(); ++i) S += add_node(q0, i, h);
+  for (int i = 0; i < weights_.size(); ++i) S += add_node(q0, i, h, with_hessian);
   return S;
 }
 
@@ -178,6 +182,7 @@ void LieGroupGalerkinDiscreteLagrangian::newton(const double* q0, const double* 
   auto residual = residual_.head(size);
   auto update = update_.head(size);
   auto jacobian = jacobian_.topLeftCorner(size, size);
+  double previous_update = 0.0;
   for (int iteration = 0;; ++iteration) {
     action(q0, h);
     if (p0 != nullptr) dexp_with_derivatives(q0, xi_.col(s_).data(), 1.0);
@@ -198,8 +203,17 @@ void LieGroupGalerkinDiscreteLagrangian::newton(const double* q0, const double* 
     lu_.compute(jacobian);
     update = lu_.solve(residual);
     xi_.middleCols(1, unknowns_).reshaped() -= update;
-    if (options_.converged(update.lpNorm<Eigen::Infinity>(), xi_.lpNorm<Eigen::Infinity>())) {
-      action(q0, h);
+    // Converged when the update, or the error left after it, is below the tolerance. With the
+    // contraction theta = |update_k| / |update_{k-1}| the error left is about
+    // theta / (1 - theta) |update_k| (Hairer & Wanner, Solving ODEs II, sec. IV.8); Newton's
+    // quadratic convergence makes it tiny after an update of 1e-9, saving the Hessians of an
+    // iteration that would only confirm it.
+    const double size_of_update = update.lpNorm<Eigen::Infinity>();
+    const double theta = previous_update > 0.0 ? size_of_update / previous_update : 1.0;
+    const double left = theta < 1.0 ? std::min(1.0, theta / (1.0 - theta)) * size_of_update : size_of_update;
+    previous_update = size_of_update;
+    if (options_.converged(left, xi_.lpNorm<Eigen::Infinity>())) {
+      action(q0, h, false);
       return statistics_.record(iteration + 1);
     }
   }
@@ -244,7 +258,7 @@ void LieGroupGalerkinDiscreteLagrangian::evaluate(const double* q0, const double
   for (int nu = 0; nu < s_; ++nu) xi_.col(nu) = basis_.control_times[nu] * xi_.col(s_);
   unknowns_ = s_ - 1;
   if (unknowns_ > 0) newton(q0, nullptr, h);
-  const double S = action(q0, h);
+  const double S = action(q0, h, false);
   const auto sigma = gradient_.segment(s_ * n_, n_);
   if (Ld != nullptr) *Ld = S;
   if (D1 != nullptr) {

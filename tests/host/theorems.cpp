@@ -202,3 +202,17 @@ TEST_CASE("galerkin on SO(3) in the natural chart (scenes/paper/*-galerkin-*.jso
     CHECK(v["self_adjoint"].predicted.is_null());
   }
 }
+
+TEST_CASE("on SO(3) symplecticity is measured in canonical chart coordinates: the LGVI is symplectic, explicit "
+          "midpoint in the embedding (RK) is not") {
+  const auto verified = [](const char* file) {
+    return Verified(json::parse(varia::test::read_file(varia::test::kSourceDir / "scenes/paper" / file)));
+  };
+  const Verified lgvi = verified("rigid-body-lgvi-cayley.json"), rk = verified("rigid-body-rk.json");
+  MESSAGE("LGVI: " << *lgvi["symplectic"].measured << ", RK: " << *rk["symplectic"].measured << " ("
+                   << rk["symplectic"].note << ")");
+  CHECK(lgvi["symplectic"].predicted == true);
+  CHECK(lgvi["symplectic"].holds == true);
+  CHECK(rk["symplectic"].predicted == false);
+  CHECK(rk["symplectic"].holds == false);
+}

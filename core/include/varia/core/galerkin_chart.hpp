@@ -58,11 +58,11 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   const std::vector<double>& last_residuals() const { return residuals_; }
 
  private:
-  // S and, in gradient_ and hessian_, its derivatives in (eta, xi^1, ..., xi^s) (blocks of n
-  // numbers; block 0 is eta) for the control points in xi_ and the base point q0.
-  double action(const double* q0, double h);
+  // S and, in gradient_ and (with_hessian) hessian_, its derivatives in (eta, xi^1, ..., xi^s)
+  // (blocks of n numbers; block 0 is eta) for the control points in xi_ and the base point q0.
+  double action(const double* q0, double h, bool with_hessian = true);
   // Adds quadrature node i: L at the chart curve and the chain rule through the chart's jets.
-  double add_node(const double* q0, int i, double h);
+  double add_node(const double* q0, int i, double h, bool with_hessian);
   // dexp_{sign w} (= d velocity / d xi_dot at xi = -sign w) into dexp_, its inverse transpose,
   // and its derivatives in (sign w)_l (one n x n matrix each), from the manifold's chart at jets.
   void dexp_with_derivatives(const double* q0, const double* w, double sign);
