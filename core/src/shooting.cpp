@@ -54,7 +54,7 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
                                                        SolverOptions options, std::vector<Force*> forces)
     : manifold_(manifold),
       lagrangian_(checked(manifold, lagrangian, form)),
-      forces_(std::move(forces), manifold.dim(), manifold.dim()),
+      forces_(std::move(forces), manifold.point_size(), manifold.dim()),
       field_(field_of(manifold, lagrangian_, form, forces_)),
       mechanical_(dynamic_cast<MechanicalField*>(field_.get())),
       method_(method),

@@ -84,3 +84,13 @@ TEST_CASE("a shooting scene with forces runs them through the construction and a
     CHECK(std::abs(a - b) < 1e-6);
   }
 }
+
+TEST_CASE("forces with the shooting construction on SO(3) are refused with exit 2 (vector spaces only)") {
+  TempDir dir;
+  Json scene = Json::parse(read_file(kSourceDir / "scenes/paper/rigid-body-shooting-cg.json"));
+  scene["system"]["forces"] = Json::array({{{"type", "damping"}, {"coefficient", 0.1}}});
+  write_file(dir / "so3-forces.json", scene.dump());
+  const Outcome outcome = run_varia("run '" + (dir / "so3-forces.json").string() + "'");
+  CHECK(outcome.code == 2);
+  CHECK(outcome.err.find("the shooting construction takes forces on vector spaces only") != std::string::npos);
+}
