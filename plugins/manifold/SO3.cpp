@@ -60,13 +60,7 @@ class SO3 final : public varia::Manifold {
 
   // log(R0^T R) at jets (so3::log is templated on the scalar).
   varia::Status local_jets(const double* q0, const varia::Jet2* q, varia::Jet2* xi) noexcept override {
-    using JetMatrix = varia::so3::Matrix3<varia::Jet2>;
-    JetMatrix R;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R(r, c) = q[3 * r + c];
-    const JetMatrix D = from_row_major(q0).transpose().cast<varia::Jet2>() * R;
-    const varia::so3::Vector3<varia::Jet2> w = varia::so3::log(D);
-    for (int i = 0; i < 3; ++i) xi[i] = w(i);
+    varia::so3::local_jets(q0, q, xi);
     return nullptr;
   }
 

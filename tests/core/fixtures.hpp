@@ -81,6 +81,10 @@ struct Rotations : Manifold {
     so3::chart_jets(q0, xi, xi_dot, point, velocity);
     return nullptr;
   }
+  Status local_jets(const double* q0, const Jet2* q, Jet2* xi) noexcept override {
+    so3::local_jets(q0, q, xi);
+    return nullptr;
+  }
   bool contains(const double*, char*, int) noexcept override { return true; }
 };
 

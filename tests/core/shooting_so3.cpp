@@ -18,18 +18,6 @@ using namespace varia::testing;
 
 namespace {
 
-// The fixture's SO(3) with the chart's inverse at jets (the SO3 plugin's local_jets).
-struct ChartedRotations : Rotations {
-  Status local_jets(const double* q0, const Jet2* q, Jet2* xi) noexcept override {
-    so3::Matrix3<Jet2> R;
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) R(r, c) = q[3 * r + c];
-    const so3::Vector3<Jet2> w = so3::log(so3::Matrix3<Jet2>(so3::from_row_major(q0).transpose().cast<Jet2>() * R));
-    for (int i = 0; i < 3; ++i) xi[i] = w(i);
-    return nullptr;
-  }
-};
-
 struct Composition {
   std::string name;
   std::shared_ptr<OneStepMethod> method;
@@ -48,7 +36,7 @@ std::vector<Composition> compositions() {
 
 TEST_CASE("shooting on SO(3): crouch-grossman 2 + trapezoid and implicit midpoint + trapezoid converge at "
           "order 2, crouch-grossman 3 + simpson at order 3 (free body and heavy top)") {
-  ChartedRotations group;
+  Rotations group;
   for (bool top : {false, true}) {
     const Problem p = top ? heavy_top() : free_body();
     const double t_end = 2.0;
@@ -73,7 +61,7 @@ TEST_CASE("shooting on SO(3): crouch-grossman 2 + trapezoid and implicit midpoin
 
 TEST_CASE("shooting on SO(3) with crouch-grossman: the spatial angular momentum R Pi and R^T R = I hold to "
           "round-off over 10^4 steps of the free body") {
-  ChartedRotations group;
+  Rotations group;
   Problem p = free_body();
   auto method = crouch_grossman(2);
   FixedRule rule = trapezoid();
@@ -99,7 +87,7 @@ TEST_CASE("shooting on SO(3) with crouch-grossman: the spatial angular momentum 
 
 TEST_CASE("shooting on SO(3): the heavy top's vertical spatial momentum e3 . R Pi is conserved, the horizontal "
           "part is not") {
-  ChartedRotations group;
+  Rotations group;
   Problem p = heavy_top();
   auto method = crouch_grossman(3);
   FixedRule rule = simpson();
@@ -120,7 +108,7 @@ TEST_CASE("shooting on SO(3): the heavy top's vertical spatial momentum e3 . R P
 
 TEST_CASE("shooting on SO(3): L_d's D1 and D2 at (q0, q1) of a step are -p0 and p1 (left-trivialized body "
           "momenta), through the chart at q1") {
-  ChartedRotations group;
+  Rotations group;
   Problem p = heavy_top();
   for (Composition& c : compositions()) {
     ShootingDiscreteLagrangian map(group, p.top, c.rule, *c.method, ShootingForm::lagrangian, SolverOptions{});
@@ -137,7 +125,7 @@ TEST_CASE("shooting on SO(3): L_d's D1 and D2 at (q0, q1) of a step are -p0 and 
 }
 
 TEST_CASE("shooting on SO(3) refuses the type-2 form") {
-  ChartedRotations group;
+  Rotations group;
   Problem p = free_body();
   auto method = crouch_grossman(2);
   FixedRule rule = trapezoid();

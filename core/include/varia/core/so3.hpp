@@ -245,6 +245,19 @@ void chart_jets(const double* R0, const double* xi, const double* xi_dot, Jet* p
   }
 }
 
+// The natural chart's inverse at jets (Manifold::local_jets): xi = log(R0^T R) for R given as 9
+// row-major jets.
+template <class Jet>
+void local_jets(const double* R0, const Jet* q, Jet* xi) {
+  Matrix3<Jet> R;
+  for (int r = 0; r < 3; ++r)
+    for (int c = 0; c < 3; ++c) R(r, c) = q[3 * r + c];
+  const Matrix3<Jet> base = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R0)
+                                .template cast<Jet>();
+  const Vector3<Jet> w = log(Matrix3<Jet>(base.transpose() * R));
+  for (int i = 0; i < 3; ++i) xi[i] = w(i);
+}
+
 // Row-major 9-number buffers <-> matrices (the spec's layout of a point).
 inline Matrix3<double> from_row_major(const double* q) {
   return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(q);
