@@ -343,13 +343,15 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
   sparse_.analyzed = false;
 }
 
-void GalerkinDiscreteLagrangian::solve_dense(int first_unknown, int first_equation, int blocks) {
+void GalerkinDiscreteLagrangian::solve_dense(int first_unknown, int first_equation, int blocks, bool refactor) {
   const int size = blocks * n_;
   auto residual = residual_.head(size);
   auto update = update_.head(size);
   if (size == jacobian_.rows()) {
-    jacobian_ = hessian_.block(first_equation * n_, first_unknown * n_, size, size);
-    lu_.compute(jacobian_);
+    if (refactor) {
+      jacobian_ = hessian_.block(first_equation * n_, first_unknown * n_, size, size);
+      lu_.compute(jacobian_);
+    }
     update.noalias() = lu_.solve(residual);
   } else {
     update = hessian_.block(first_equation * n_, first_unknown * n_, size, size).partialPivLu().solve(residual);
@@ -358,12 +360,13 @@ void GalerkinDiscreteLagrangian::solve_dense(int first_unknown, int first_equati
 
 // Eigen's SparseLU: the symbolic analysis (COLAMD ordering) once per structure, the numerical
 // factorization per Newton iteration.
-void GalerkinDiscreteLagrangian::solve_sparse() {
+void GalerkinDiscreteLagrangian::solve_sparse(bool refactor) {
   if (!sparse_.analyzed) {
     sparse_.lu.analyzePattern(sparse_.matrix);
     sparse_.analyzed = true;
+    refactor = true;
   }
-  sparse_.lu.factorize(sparse_.matrix);
+  if (refactor) sparse_.lu.factorize(sparse_.matrix);
   if (sparse_.lu.info() != Eigen::Success)
     throw NumericalFailure("the Galerkin Newton Jacobian is singular: " + sparse_.lu.lastErrorMessage(),
                            std::nan(""));
@@ -375,8 +378,10 @@ void GalerkinDiscreteLagrangian::solve_sparse() {
 // one more update (its Jacobian is at hand; no evaluation is needed, see gradient_after_update):
 // a residual left at the tolerance, e.g. by a warm start that passes the test at once, has the
 // same sign from step to step and adds up over a run (bench/README.md), where the update takes it
-// to round-off. A solve also ends when an update is below tolerance relative to the offsets
-// q^nu - q^0. The iterations counted are the updates taken.
+// to round-off. That last update, after an iteration, reuses the last iteration's factorization
+// (the Jacobians differ by O(last update), so the update's error is O(last update x this update),
+// far below round-off). A solve also ends when an update is below tolerance relative to the
+// offsets q^nu - q^0. The iterations counted are the updates taken.
 void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
                                         int blocks, const double* p0, bool forced) {
   const int size = blocks * n_;
@@ -403,10 +408,11 @@ void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_e
       throw NumericalFailure("Newton's method did not converge in " +
                                  std::to_string(options_.max_iterations) + " iterations",
                              norm);
+    const bool refactor = !(converged && iteration > 0);
     if (sparse)
-      solve_sparse();
+      solve_sparse(refactor);
     else
-      solve_dense(first_unknown, first_equation, blocks);
+      solve_dense(first_unknown, first_equation, blocks, refactor);
     points_.middleCols(first_unknown, blocks).reshaped() -= update;
     if (converged || options_.converged(update.lpNorm<Eigen::Infinity>(), points_.lpNorm<Eigen::Infinity>())) {
       gradient_after_update(h, first_unknown, size, forced);

@@ -104,3 +104,34 @@ TEST_CASE("galerkin explicit form for a constant mass matrix agrees with the New
   CHECK(direct.evaluations().hessian == 0);
   CHECK(newton.solver_statistics().max_iterations >= 1);
 }
+
+// Order 8 (degree 4, 5 Gauss-Lobatto points) on the pendulum from rest at 1.3 to T = 100: at
+// 1376 and 2752 steps the discretization error is below 1e-14, so the two runs must agree to
+// round-off. A solve that stops at a residual of about its tolerance (1e-14 (1 + scale)) leaves
+// an error of the same sign at every step, which grows with the number of steps: the runs then
+// differed by 2.8e-13 (bench/README.md).
+TEST_CASE("galerkin Newton solves to round-off: order-8 runs at 1376 and 2752 steps agree") {
+  FlatSpace space(1);
+  Pendulum pendulum;
+  const double a = std::sqrt(3.0 / 7.0);
+  FixedRule rule({0.0, (1 - a) / 2, 0.5, (1 + a) / 2, 1.0}, {1.0 / 20, 49.0 / 180, 16.0 / 45, 49.0 / 180, 1.0 / 20},
+                 7);
+  double end[2][2];
+  for (int k = 0; k < 2; ++k) {
+    GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(4), {});
+    const long steps = 1376L << k;
+    double q = 1.3, p = 0.0, q1, p1;
+    for (long i = 0; i < steps; ++i) {
+      galerkin.step(&q, &p, 100.0 / steps, &q1, &p1);
+      q = q1;
+      p = p1;
+    }
+    end[k][0] = q;
+    end[k][1] = p;
+    MESSAGE("order 8, ", steps, " steps: Newton updates per step ", galerkin.solver_statistics().mean());
+  }
+  CAPTURE(end[0][0] - end[1][0]);
+  CAPTURE(end[0][1] - end[1][1]);
+  CHECK(std::abs(end[0][0] - end[1][0]) < 2e-14);
+  CHECK(std::abs(end[0][1] - end[1][1]) < 2e-14);
+}

@@ -85,9 +85,10 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // where p0 (if not null) is added to the equation nu = 0 (IDEL: p0 + D1 L_d + f_d^0 = 0).
   void newton(double h, int first_unknown, int first_equation, int blocks, const double* p0,
               bool forced);
-  // Solves J update = residual with the Jacobian block of the current equations and unknowns.
-  void solve_dense(int first_unknown, int first_equation, int blocks);
-  void solve_sparse();
+  // Solves J update = residual with the Jacobian block of the current equations and unknowns,
+  // factorized anew or (refactor false) as last factorized.
+  void solve_dense(int first_unknown, int first_equation, int blocks, bool refactor);
+  void solve_sparse(bool refactor);
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
   void gradient_after_update(double h, int first_unknown, int size, bool forced);
