@@ -46,9 +46,7 @@ class SO3 final : public varia::Manifold {
   }
 
   varia::Status local(const double* q0, const double* q, double* xi) noexcept override {
-    const Eigen::Vector3d w =
-        varia::so3::log(Eigen::Matrix3d(from_row_major(q0).transpose() * from_row_major(q)));
-    for (int i = 0; i < 3; ++i) xi[i] = w(i);
+    varia::so3::chart_local(q0, q, xi);
     return nullptr;
   }
 
@@ -60,7 +58,7 @@ class SO3 final : public varia::Manifold {
 
   // log(R0^T R) at jets (so3::log is templated on the scalar).
   varia::Status local_jets(const double* q0, const varia::Jet2* q, varia::Jet2* xi) noexcept override {
-    varia::so3::local_jets(q0, q, xi);
+    varia::so3::chart_local(q0, q, xi);
     return nullptr;
   }
 

@@ -72,8 +72,7 @@ struct Rotations : Manifold {
     return nullptr;
   }
   Status local(const double* q0, const double* q, double* xi) noexcept override {
-    const Eigen::Matrix3d D = so3::from_row_major(q0).transpose() * so3::from_row_major(q);
-    Eigen::Map<Eigen::Vector3d>{xi} = so3::log(D);
+    so3::chart_local(q0, q, xi);
     return nullptr;
   }
   Status chart_jets(const double* q0, const double* xi, const double* xi_dot, Jet2* point,
@@ -82,7 +81,7 @@ struct Rotations : Manifold {
     return nullptr;
   }
   Status local_jets(const double* q0, const Jet2* q, Jet2* xi) noexcept override {
-    so3::local_jets(q0, q, xi);
+    so3::chart_local(q0, q, xi);
     return nullptr;
   }
   bool contains(const double*, char*, int) noexcept override { return true; }

@@ -78,9 +78,9 @@ TEST_CASE("shooting on SO(3) with crouch-grossman: the spatial angular momentum 
                                                       << "), max ||I - R^T R|| " << orthogonality
                                                       << ", Newton iterations per step " << map.solver_statistics().mean()
                                                       << " (max " << map.solver_statistics().max_iterations << ")");
-  // Round-off accumulating without compensated summation (about eps |pi0| per step), against the
-  // O(1) change of a non-conserved component (next case).
-  CHECK(momentum < 1e-10);
+  // Round-off accumulating without compensated summation (8.7e-13 measured; 2.7e-11 when the
+  // chart's inverse used R0^T), against the O(1) change of a non-conserved component (next case).
+  CHECK(momentum < 1e-11);
   CHECK(orthogonality < 1e-12);
   CHECK(map.solver_statistics().mean() <= 3.0);
 }
