@@ -131,9 +131,9 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
 double LieGroupGalerkinDiscreteLagrangian::action(const double* q0, double h, bool with_hessian) {
   gradient_.setZero();
   if (with_hessian) hessian_.setZero();
-  double S = 0.0;
-  for (int i = 0; i < weights_.size(); ++i) S += add_node(q0, i, h, with_hessian);
-  return S;
+  action_ = 0.0;
+  for (int i = 0; i < weights_.size(); ++i) action_ += add_node(q0, i, h, with_hessian);
+  return action_;
 }
 
 // dexp_{sign w} is d(velocity)/d(xi_dot) of the chart curve at xi = -w (velocity = dexp_{-xi} xi_dot),
@@ -257,10 +257,13 @@ void LieGroupGalerkinDiscreteLagrangian::evaluate(const double* q0, const double
   check(manifold_.local(q0, q1, xi_.col(s_).data()));
   for (int nu = 0; nu < s_; ++nu) xi_.col(nu) = basis_.control_times[nu] * xi_.col(s_);
   unknowns_ = s_ - 1;
-  if (unknowns_ > 0) newton(q0, nullptr, h);
-  const double S = action(q0, h, false);
+  // Newton leaves the action and its gradient at the solution.
+  if (unknowns_ > 0)
+    newton(q0, nullptr, h);
+  else
+    action(q0, h, false);
   const auto sigma = gradient_.segment(s_ * n_, n_);
-  if (Ld != nullptr) *Ld = S;
+  if (Ld != nullptr) *Ld = action_;
   if (D1 != nullptr) {
     dexp_with_derivatives(q0, xi_.col(s_).data(), 1.0);
     Eigen::Map<Eigen::VectorXd>(D1, n_) = gradient_.head(n_) - dexp_inverse_T_ * sigma;

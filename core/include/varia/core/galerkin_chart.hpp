@@ -58,7 +58,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   const std::vector<double>& last_residuals() const { return residuals_; }
 
  private:
-  // S and, in gradient_ and (with_hessian) hessian_, its derivatives in (eta, xi^1, ..., xi^s)
+  // S (also kept in action_) and, in gradient_ and (with_hessian) hessian_, its derivatives in (eta, xi^1, ..., xi^s)
   // (blocks of n numbers; block 0 is eta) for the control points in xi_ and the base point q0.
   double action(const double* q0, double h, bool with_hessian = true);
   // Adds quadrature node i: L at the chart curve and the chain rule through the chart's jets.
@@ -92,6 +92,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   std::vector<Jet2> point_, velocity_;
   Eigen::VectorXd node_xi_, node_rate_, q_, v_, grad_, node_gradient_;
   Eigen::MatrixXd hess_, chain_, hess_chain_, node_hessian_;
+  double action_ = 0.0;        // S at the last evaluation
   Eigen::VectorXd gradient_;  // n (s+1)
   Eigen::MatrixXd hessian_;   // n (s+1) square
   Eigen::MatrixXd dexp_, dexp_inverse_T_;            // dexp_{w}, dexp_w^{-T}
