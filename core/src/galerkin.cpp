@@ -1,6 +1,7 @@
 #include "varia/core/galerkin.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -123,11 +124,11 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
     entries_.push_back(Entry{forces_.rows()[e], forces_.cols()[e] % n_, false, forces_.cols()[e] >= n_});
   if (explicit_form_applies(quadrature)) {
     switch (n_) {
-      case 1: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<1>; break;
-      case 2: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<2>; break;
-      case 3: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<3>; break;
-      case 4: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<4>; break;
-      default: explicit_step_ = &GalerkinDiscreteLagrangian::explicit_step<Eigen::Dynamic>;
+      case 1: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<1>; break;
+      case 2: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<2>; break;
+      case 3: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<3>; break;
+      case 4: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<4>; break;
+      default: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<Eigen::Dynamic>;
     }
   }
 }
@@ -166,34 +167,57 @@ bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
 // L_d = h (b0 L(q0, v) + b1 L(q1, v)), v = (q1 - q0)/h, L = v.Mv/2 - V(q), b0 + b1 = 1:
 //   p0 = -D1 L_d = M v - h b0 dL/dq(q0)  =>  v = M^{-1} (p0 + h b0 dL/dq(q0)), q1 = q0 + h v,
 //   p1 =  D2 L_d = M v + h b1 dL/dq(q1)
-// (paper, sec. 2: degree 1 with the trapezoidal rule is Stormer-Verlet). N is n, or Dynamic:
-// the workspace is the class's dynamic vectors seen through fixed-size maps, so a step makes one
-// plugin call and no dynamic-size arithmetic for n <= 4.
+// (paper, sec. 2: degree 1 with the trapezoidal rule is Stormer-Verlet), `steps` times in place.
+// N is n, or Dynamic. For a fixed N the state (q, p, dL/dq) is held in local fixed-size vectors
+// across the steps, and the plugin reads q and writes [dL/dq, dL/dv] in one small local array
+// (`io`): a step is a few registers' arithmetic and one plugin call. (With the plugin's input and
+// output in the class's heap vectors the same loop took 40 ns a step instead of 29 on the
+// benchmark machine: bench/README.md.) The dynamic form works on the caller's arrays and the
+// class's workspace; neither allocates.
 template <int N>
-void GalerkinDiscreteLagrangian::explicit_step(const double* q0, const double* p0, double h,
-                                               double* q1, double* p1) {
+void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h, long steps) {
   using Vector = Eigen::Matrix<double, N, 1>;
   using Matrix = Eigen::Matrix<double, N, N>;
-  const Eigen::Map<const Vector> start(q0, n_), momentum(p0, n_);
   const Eigen::Map<const Matrix> mass(mass_matrix_.data(), n_, n_), inverse(inverse_mass_.data(), n_, n_);
-  const Eigen::Map<const Vector> dLdq(grad_.data(), n_);  // the head of [dL/dq, dL/dv]
-  Eigen::Map<Vector> force(force_.data(), n_), last(last_q_.data(), n_), kick(q_.data(), n_),
-      velocity(v_.data(), n_);
-  if (!has_force_ || last != start) {
-    lagrangian_.gradient(q0, v_.data(), grad_.data());  // dL/dq does not depend on v here
-    force = dLdq;
+  Eigen::Map<Vector> position(q, n_), momentum(p, n_), force(force_.data(), n_), last(last_q_.data(), n_);
+  if (!has_force_ || last != position) {
+    lagrangian_.gradient(q, v_.data(), grad_.data());  // dL/dq does not depend on v here
+    force = grad_.head(n_);
   }
-  kick = momentum + (h * b0_) * force;
-  velocity.noalias() = inverse * kick;
-  Eigen::Map<Vector> end(q1, n_), momentum1(p1, n_);
-  end = start + h * velocity;
-  lagrangian_.gradient(q1, v_.data(), grad_.data());
-  force = dLdq;
-  last = end;
+  // Steps from qk, pk with f = dL/dq(qk); `at` holds q, v (any: dL/dq does not depend on it) and
+  // receives the gradient at `gradient`.
+  auto run = [&](auto& qk, auto& pk, auto& f, auto& velocity, auto& at, double* v, double* gradient) {
+    const Eigen::Map<const Vector> dLdq(gradient, n_);  // the head of [dL/dq, dL/dv]
+    for (long k = 0; k < steps; ++k) {
+      velocity.noalias() = inverse * (pk + (h * b0_) * f);
+      qk += h * velocity;
+      at = qk;
+      lagrangian_.gradient(at.data(), v, gradient);
+      f = dLdq;
+      pk.noalias() = mass * velocity;
+      pk += (h * b1_) * f;
+    }
+  };
+  if constexpr (N == Eigen::Dynamic) {
+    Eigen::Map<Vector> velocity(velocity_.data(), n_), at(q_.data(), n_);
+    run(position, momentum, force, velocity, at, v_.data(), grad_.data());
+  } else {
+    alignas(64) std::array<double, 4 * N> io{};  // q, v = 0, then [dL/dq, dL/dv]
+    Eigen::Map<Vector> at(io.data());
+    Vector qk = position, pk = momentum, f = force, velocity;
+    run(qk, pk, f, velocity, at, io.data() + N, io.data() + 2 * N);
+    position = qk;
+    momentum = pk;
+    force = f;
+  }
+  last = position;
   has_force_ = true;
-  momentum1.noalias() = mass * velocity;
-  momentum1 += (h * b1_) * force;
-  statistics_.record(0);
+  statistics_.solves += steps;  // explicit: no Newton iterations
+}
+
+void GalerkinDiscreteLagrangian::advance(double* q, double* p, double h, long steps, double* q1, double* p1) {
+  if (explicit_advance_ == nullptr) return DiscreteHamiltonianMap::advance(q, p, h, steps, q1, p1);
+  (this->*explicit_advance_)(q, p, h, steps);
 }
 
 // q_i = q^0 + sum_nu l_nu(c_i) (q^nu - q^0) (sum_nu l_nu = 1), v_i = (1/h) sum_nu l'_nu(c_i) (q^nu - q^0).
@@ -234,7 +258,7 @@ double GalerkinDiscreteLagrangian::action(double h, Order order, bool forced) {
     else if (order == Order::hessian)
       L = lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data());
     else if (order == Order::gradient)
-      L = lagrangian_.gradient(q_.data(), v_.data(), grad_.data());
+      L = lagrangian_.value_and_gradient(q_.data(), v_.data(), grad_.data());
     else
       L = lagrangian_.value(q_.data(), v_.data());
     const double b = weights_[i];
@@ -459,7 +483,11 @@ void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, 
 // (compensated.hpp) when a step continues from the last one's output.
 void GalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double h, double* q1,
                                       double* p1) {
-  if (explicit_step_ != nullptr) return (this->*explicit_step_)(q0, p0, h, q1, p1);
+  if (explicit_advance_ != nullptr) {
+    std::copy_n(q0, n_, q1);
+    std::copy_n(p0, n_, p1);
+    return (this->*explicit_advance_)(q1, p1, h, 1);
+  }
   const Eigen::Map<const Eigen::VectorXd> start(q0, n_), momentum(p0, n_);
   if (!(has_previous_ && previous_end_ == start && end_p_ == momentum)) {
     carry_q_.setZero();

@@ -92,7 +92,7 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
   for (int k = 0; k < m_; ++k) q_(k) = reduced_ ? q0[k] : point_[k].value;  // reduced: l = L(g0, .)
   for (int k = 0; k < n; ++k) v_(k) = velocity_[k].value;
   const double L = with_hessian ? lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data())
-                                : lagrangian_.gradient(q_.data(), v_.data(), grad_.data());
+                                : lagrangian_.value_and_gradient(q_.data(), v_.data(), grad_.data());
   if (!reduced_)
     for (int k = 0; k < m_; ++k) chain_.row(k).head(2 * n) = point_[k].gradient.transpose();
   for (int k = 0; k < n; ++k) chain_.row(m_ + k).tail(2 * n) = velocity_[k].gradient.transpose();

@@ -46,11 +46,20 @@ double LagrangianEvaluator::value(const double* q, const double* v) {
   return L;
 }
 
-double LagrangianEvaluator::gradient(const double* q, const double* v, double* gradient) {
-  double L = 0.0;
-  check(lagrangian_.evaluate(q, v, &L, gradient, nullptr), "Lagrangian gradient");
+void LagrangianEvaluator::evaluate_gradient(const double* q, const double* v, double* value, double* gradient) {
+  check(lagrangian_.evaluate(q, v, value, gradient, nullptr), "Lagrangian gradient");
   ++counters_.gradient;
   check_finite(gradient, m_ + n_, "gradient");
+}
+
+void LagrangianEvaluator::gradient(const double* q, const double* v, double* gradient) {
+  evaluate_gradient(q, v, nullptr, gradient);
+}
+
+double LagrangianEvaluator::value_and_gradient(const double* q, const double* v, double* gradient) {
+  double L = 0.0;
+  evaluate_gradient(q, v, &L, gradient);
+  check_finite(&L, 1, "value");
   return L;
 }
 
@@ -135,7 +144,7 @@ void LagrangianEvaluator::velocity_newton_update(const double* q, const double* 
 }
 
 double LagrangianEvaluator::energy(const double* q, const double* v) {
-  const double L = gradient(q, v, gradient_.data());
+  const double L = value_and_gradient(q, v, gradient_.data());
   return gradient_.tail(n_).dot(Eigen::Map<const Eigen::VectorXd>(v, n_)) - L;
 }
 

@@ -3,6 +3,8 @@
 // options, evaluation counters, Newton statistics, and the numerical failure they raise.
 #pragma once
 
+#include <algorithm>
+
 #include <Eigen/Core>
 #include <stdexcept>
 #include <string>
@@ -56,6 +58,18 @@ class DiscreteHamiltonianMap {
   virtual int dim() const = 0;         // numbers per momentum
   // One step of size h from (q0, p0) to (q1, p1). Throws NumericalFailure.
   virtual void step(const double* q0, const double* p0, double h, double* q1, double* p1) = 0;
+  // `steps` steps of size h from (q, p), in place, with nothing observed in between (the loop
+  // `varia cost` and the benchmarks time); q1, p1 are workspace of q's and p's sizes. A map may
+  // override it to keep its state in registers across steps (the explicit Galerkin form does).
+  // Throws NumericalFailure, and (q, p) are then unspecified: a caller that needs the last good
+  // state steps with step().
+  virtual void advance(double* q, double* p, double h, long steps, double* q1, double* p1) {
+    for (long k = 0; k < steps; ++k) {
+      step(q, p, h, q1, p1);
+      std::copy_n(q1, point_size(), q);
+      std::copy_n(p1, dim(), p);
+    }
+  }
   // The time at the start of the next step, for time-dependent forces (force.hpp); a map with
   // forces advances it by h on each step. Maps without forces ignore it.
   virtual void set_time(double /*t*/) {}

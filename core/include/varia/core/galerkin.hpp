@@ -57,6 +57,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   int point_size() const override { return n_; }
   int dim() const override { return n_; }
   void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
+  void advance(double* q, double* p, double h, long steps, double* q1, double* p1) override;
   void set_time(double t) override { t_ = t; }
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override;
@@ -94,13 +95,13 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void gradient_after_update(double h, int first_unknown, int size, bool forced);
   void warm_start(const double* q0, const double* p0, double h);
   // Degree 1 with nodes only at 0 and 1 and a constant mass matrix M: the IDEL equations are
-  // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton. The step is compiled
-  // for N = n (fixed-size arithmetic) when n <= 4, for Eigen::Dynamic otherwise, and chosen once.
+  // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton. The steps are
+  // compiled for N = n (fixed-size arithmetic, the state in registers across steps) when n <= 4,
+  // for Eigen::Dynamic otherwise, and chosen once.
   bool explicit_form_applies(Quadrature& quadrature);
   template <int N>
-  void explicit_step(const double* q0, const double* p0, double h, double* q1, double* p1);
-  using StepFunction = void (GalerkinDiscreteLagrangian::*)(const double*, const double*, double,
-                                                            double*, double*);
+  void explicit_advance(double* q, double* p, double h, long steps);
+  using AdvanceFunction = void (GalerkinDiscreteLagrangian::*)(double*, double*, double, long);
 
   LagrangianEvaluator lagrangian_;
   Forces forces_;
@@ -151,9 +152,10 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
     bool analyzed = false;
   };
   SparseJacobian sparse_;
-  // The explicit form: its step (null when it does not apply), endpoint weights, M and M^{-1},
-  // and dL/dq at the last q1 (reused as dL/dq at the next q0: one gradient evaluation per step).
-  StepFunction explicit_step_ = nullptr;
+  // The explicit form: its steps (null when it does not apply), endpoint weights, M and M^{-1},
+  // and dL/dq at the last q1 (reused as dL/dq at the next q0: one gradient evaluation per step);
+  // velocity_ is the dynamic-size form's workspace.
+  AdvanceFunction explicit_advance_ = nullptr;
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;
   Eigen::VectorXd force_, last_q_;

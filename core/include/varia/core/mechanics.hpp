@@ -23,8 +23,10 @@ class LagrangianEvaluator {
   int position_size() const { return m_; }
   int velocity_size() const { return n_; }
   double value(const double* q, const double* v);
-  // gradient: m + n numbers [dL/dq, dL/dv].
-  double gradient(const double* q, const double* v, double* gradient);
+  // gradient: m + n numbers [dL/dq, dL/dv]; the plugin is not asked for L.
+  void gradient(const double* q, const double* v, double* gradient);
+  // L, and its gradient as above.
+  double value_and_gradient(const double* q, const double* v, double* gradient);
   // hessian: (m+n)^2 numbers, dense column-major (sparse Lagrangians are expanded).
   double hessian(const double* q, const double* v, double* gradient, double* hessian);
   // A sparse Lagrangian's Hessian values, one per entry of its pattern (pattern_rows/cols).
@@ -47,6 +49,8 @@ class LagrangianEvaluator {
 
  private:
   void check_finite(const double* values, int count, const char* what) const;
+  // The gradient, and L where value is not null.
+  void evaluate_gradient(const double* q, const double* v, double* value, double* gradient);
   // One Newton step of the inverse Legendre transform: residual_ and update_ (see the .cpp).
   void velocity_newton_update(const double* q, const double* v, const double* p);
   Lagrangian& lagrangian_;

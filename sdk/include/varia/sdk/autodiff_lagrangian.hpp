@@ -56,8 +56,10 @@ class AutodiffLagrangian : public Lagrangian {
         dispatch([&](auto, auto second) {
           second_order<typename decltype(second)::type>(q, v, value, gradient, hessian);
         });
+      else if (gradient != nullptr && value != nullptr)
+        dispatch([&](auto first, auto) { first_order<typename decltype(first)::type, true>(q, v, value, gradient); });
       else if (gradient != nullptr)
-        dispatch([&](auto first, auto) { first_order<typename decltype(first)::type>(q, v, value, gradient); });
+        dispatch([&](auto first, auto) { first_order<typename decltype(first)::type, false>(q, v, value, gradient); });
       else if (value != nullptr)
         *value = model().lagrangian(Vec<double>(Eigen::Map<const Vec<double>>(q, m_)),
                                     Vec<double>(Eigen::Map<const Vec<double>>(v, n_)));
@@ -109,8 +111,11 @@ class AutodiffLagrangian : public Lagrangian {
   // fixed-size D the loop runs to the compile-time size, so that it unrolls and each seed
   // e_i is stored whole (not a zero vector then one coefficient, which the next whole-vector
   // load has to wait for).
-  template <class D>
-  void first_order(const double* q, const double* v, double* value, double* gradient) const {
+  // Without the value (WithValue false), what only L needs is dead code once the model is inlined
+  // (flatten: the model and Eigen's dual arithmetic are inlined here) (cos q of the pendulum's m g l cos q, whose derivative needs sin q alone): math functions are
+  // pure here, since varia builds with -fno-math-errno (the evaluator checks finiteness instead).
+  template <class D, bool WithValue>
+  [[gnu::noinline, gnu::flatten]] void first_order(const double* q, const double* v, double* value, double* gradient) const {
     constexpr int fixed = D::DerType::SizeAtCompileTime;
     const int k = fixed > 0 ? fixed : m_ + n_;
     Vec<D> qd(m_), vd(n_);
@@ -120,13 +125,13 @@ class AutodiffLagrangian : public Lagrangian {
       z.derivatives() = D::DerType::Unit(k, i);
     }
     const D r = model().lagrangian(qd, vd);
-    if (value != nullptr) *value = r.value();
+    if constexpr (WithValue) *value = r.value();
     for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : 0.0;
   }
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).
   template <class D2>
-  void second_order(const double* q, const double* v, double* value, double* gradient,
+  [[gnu::noinline]] void second_order(const double* q, const double* v, double* value, double* gradient,
                     double* hessian) const {
     using D = typename D2::Scalar;
     using Inner = typename D::DerType;
