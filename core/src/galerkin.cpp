@@ -186,26 +186,29 @@ void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h
   }
   // Steps from qk, pk with f = dL/dq(qk); `at` holds q, v (any: dL/dq does not depend on it) and
   // receives the gradient at `gradient`.
-  auto run = [&](auto& qk, auto& pk, auto& f, auto& velocity, auto& at, double* v, double* gradient) {
+  const double kick0 = h * b0_, kick1 = h * b1_;
+  auto run = [&](const auto& M, const auto& M_inverse, auto& qk, auto& pk, auto& f, auto& velocity,
+                 auto& at, double* v, double* gradient) {
     const Eigen::Map<const Vector> dLdq(gradient, n_);  // the head of [dL/dq, dL/dv]
     for (long k = 0; k < steps; ++k) {
-      velocity.noalias() = inverse * (pk + (h * b0_) * f);
+      velocity.noalias() = M_inverse * (pk + kick0 * f);
       qk += h * velocity;
       at = qk;
       lagrangian_.gradient(at.data(), v, gradient);
       f = dLdq;
-      pk.noalias() = mass * velocity;
-      pk += (h * b1_) * f;
+      pk.noalias() = M * velocity;
+      pk += kick1 * f;
     }
   };
   if constexpr (N == Eigen::Dynamic) {
     Eigen::Map<Vector> velocity(velocity_.data(), n_), at(q_.data(), n_);
-    run(position, momentum, force, velocity, at, v_.data(), grad_.data());
+    run(mass, inverse, position, momentum, force, velocity, at, v_.data(), grad_.data());
   } else {
     alignas(64) std::array<double, 4 * N> io{};  // q, v = 0, then [dL/dq, dL/dv]
     Eigen::Map<Vector> at(io.data());
+    const Matrix M = mass, M_inverse = inverse;
     Vector qk = position, pk = momentum, f = force, velocity;
-    run(qk, pk, f, velocity, at, io.data() + N, io.data() + 2 * N);
+    run(M, M_inverse, qk, pk, f, velocity, at, io.data() + N, io.data() + 2 * N);
     position = qk;
     momentum = pk;
     force = f;

@@ -22,20 +22,10 @@ LagrangianEvaluator::LagrangianEvaluator(Lagrangian& lagrangian)
   }
 }
 
-namespace {
-
-// The message is built out of line, so that the check that runs on every evaluation is a loop of
-// scalar loads and well-predicted branches (the plugin has just stored these numbers one by one: a
-// vectorized check would wait on each load for the stores to be forwarded).
-[[noreturn]] void not_finite(const char* what) {
+// Out of line, so that the inline check that runs on every evaluation is a loop of scalar loads
+// and well-predicted branches.
+void LagrangianEvaluator::not_finite(const char* what) {
   throw NumericalFailure(std::string("the Lagrangian's ") + what + " is not finite", std::nan(""));
-}
-
-}  // namespace
-
-void LagrangianEvaluator::check_finite(const double* values, int count, const char* what) const {
-  for (int i = 0; i < count; ++i)
-    if (!std::isfinite(values[i])) not_finite(what);
 }
 
 double LagrangianEvaluator::value(const double* q, const double* v) {
@@ -46,20 +36,9 @@ double LagrangianEvaluator::value(const double* q, const double* v) {
   return L;
 }
 
-void LagrangianEvaluator::evaluate_gradient(const double* q, const double* v, double* value, double* gradient) {
-  check(lagrangian_.evaluate(q, v, value, gradient, nullptr), "Lagrangian gradient");
-  ++counters_.gradient;
-  check_finite(gradient, m_ + n_, "gradient");
-}
-
-void LagrangianEvaluator::gradient(const double* q, const double* v, double* gradient) {
-  evaluate_gradient(q, v, nullptr, gradient);
-}
-
 double LagrangianEvaluator::value_and_gradient(const double* q, const double* v, double* gradient) {
   double L = 0.0;
   evaluate_gradient(q, v, &L, gradient);
-  check_finite(&L, 1, "value");
   return L;
 }
 

@@ -97,7 +97,7 @@ class Pendulum final : public varia::sdk::AutodiffLagrangian<Pendulum> {
   template <class T>
   T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
     using std::cos;
-    return (0.5 * mass_ * length_ * length_) * (v(0) * v(0)) + (mass_ * gravity_ * length_) * cos(q(0));
+    return (0.5 * mass_ * length_ * length_) * v(0) * v(0) + (mass_ * gravity_ * length_) * cos(q(0));
   }
 
   bool constant_mass_matrix(double* mass) const noexcept override {

@@ -105,6 +105,60 @@ TEST_CASE("galerkin explicit form for a constant mass matrix agrees with the New
   CHECK(newton.solver_statistics().max_iterations >= 1);
 }
 
+// n uncoupled pendulums with masses 1..n, declaring their constant mass matrix: the explicit form
+// at a fixed size (n <= 4) and at the dynamic size (n = 5).
+struct Pendulums : sdk::AutodiffLagrangian<Pendulums> {
+  explicit Pendulums(int n) : sdk::AutodiffLagrangian<Pendulums>(n, n), n_(n) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::cos;
+    T L = T(0.0);
+    for (int i = 0; i < n_; ++i) L += (0.5 * (i + 1)) * v(i) * v(i) + (i + 1.0) * cos(q(i));
+    return L;
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    Eigen::Map<Eigen::MatrixXd>(mass, n_, n_) = Eigen::VectorXd::LinSpaced(n_, 1, n_).asDiagonal();
+    return true;
+  }
+  int n_;
+};
+
+// advance() (the loop varia cost and the benchmarks time) must be the steps of step(), to the
+// bit: the explicit form's register loop at n = 1, 2 and 5, and the default loop (Newton) for a
+// Lagrangian that declares no constant mass matrix.
+TEST_CASE("galerkin advance takes the same steps as step, bit for bit") {
+  auto rule = trapezoid();
+  const auto compare = [&](Lagrangian& lagrangian, int n, bool explicit_form) {
+    CAPTURE(n);
+    FlatSpace space(n);
+    GalerkinDiscreteLagrangian stepped(space, lagrangian, rule, equispaced_control_times(1), {});
+    GalerkinDiscreteLagrangian advanced(space, lagrangian, rule, equispaced_control_times(1), {});
+    Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), p = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd a = q, b = p, q1(n), p1(n);
+    const long steps = 300;
+    for (long k = 0; k < steps; ++k) {
+      stepped.step(a.data(), b.data(), 0.05, q1.data(), p1.data());
+      a = q1;
+      b = p1;
+    }
+    advanced.advance(q.data(), p.data(), 0.05, steps / 2, q1.data(), p1.data());
+    advanced.advance(q.data(), p.data(), 0.05, steps / 2, q1.data(), p1.data());
+    CHECK((q.array() == a.array()).all());
+    CHECK((p.array() == b.array()).all());
+    CHECK(advanced.solver_statistics().solves == steps);
+    // The explicit form: one gradient per step (plus the first), the second call continuing from
+    // the first's dL/dq.
+    if (explicit_form) CHECK(advanced.evaluations().gradient == steps + 1);
+    CHECK(advanced.evaluations().gradient == stepped.evaluations().gradient);
+  };
+  Pendulums one(1), two(2), five(5);
+  compare(one, 1, true);
+  compare(two, 2, true);
+  compare(five, 5, true);
+  Pendulum newton;  // no constant mass matrix: Newton, and DiscreteHamiltonianMap's loop
+  compare(newton, 1, false);
+}
+
 // Order 8 (degree 4, 5 Gauss-Lobatto points) on the pendulum from rest at 1.3 to T = 100: at
 // 1376 and 2752 steps the discretization error is below 1e-14, so the two runs must agree to
 // round-off. A solve that stops at a residual of about its tolerance (1e-14 (1 + scale)) leaves

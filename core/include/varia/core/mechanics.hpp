@@ -6,6 +6,7 @@
 #include <Eigen/LU>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#include <cmath>
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
@@ -24,7 +25,7 @@ class LagrangianEvaluator {
   int velocity_size() const { return n_; }
   double value(const double* q, const double* v);
   // gradient: m + n numbers [dL/dq, dL/dv]; the plugin is not asked for L.
-  void gradient(const double* q, const double* v, double* gradient);
+  void gradient(const double* q, const double* v, double* gradient) { evaluate_gradient(q, v, nullptr, gradient); }
   // L, and its gradient as above.
   double value_and_gradient(const double* q, const double* v, double* gradient);
   // hessian: (m+n)^2 numbers, dense column-major (sparse Lagrangians are expanded).
@@ -48,9 +49,20 @@ class LagrangianEvaluator {
   double energy(const double* q, const double* v);
 
  private:
-  void check_finite(const double* values, int count, const char* what) const;
+  // Inline, with the message built out of line: the explicit Stormer-Verlet loop makes one such
+  // evaluation per step (the plugin has just stored these numbers one by one: a vectorized check
+  // would wait on each load for the stores to be forwarded).
+  void check_finite(const double* values, int count, const char* what) const {
+    for (int i = 0; i < count; ++i)
+      if (!std::isfinite(values[i])) not_finite(what);
+  }
+  [[noreturn]] static void not_finite(const char* what);
   // The gradient, and L where value is not null.
-  void evaluate_gradient(const double* q, const double* v, double* value, double* gradient);
+  void evaluate_gradient(const double* q, const double* v, double* value, double* gradient) {
+    check(lagrangian_.evaluate(q, v, value, gradient, nullptr), "Lagrangian gradient");
+    ++counters_.gradient;
+    check_finite(gradient, m_ + n_, "gradient");
+  }
   // One Newton step of the inverse Legendre transform: residual_ and update_ (see the .cpp).
   void velocity_newton_update(const double* q, const double* v, const double* p);
   Lagrangian& lagrangian_;

@@ -53,13 +53,17 @@ class AutodiffLagrangian : public Lagrangian {
                   double* hessian) noexcept final {
     return guarded(error_, [&] {
       if (hessian != nullptr)
-        dispatch([&](auto, auto second) {
+        dispatch([&](auto, auto second, auto) {
           second_order<typename decltype(second)::type>(q, v, value, gradient, hessian);
         });
       else if (gradient != nullptr && value != nullptr)
-        dispatch([&](auto first, auto) { first_order<typename decltype(first)::type, true>(q, v, value, gradient); });
+        dispatch([&](auto first, auto, auto m) {
+          first_order<typename decltype(first)::type, decltype(m)::value, true>(q, v, value, gradient);
+        });
       else if (gradient != nullptr)
-        dispatch([&](auto first, auto) { first_order<typename decltype(first)::type, false>(q, v, value, gradient); });
+        dispatch([&](auto first, auto, auto m) {
+          first_order<typename decltype(first)::type, decltype(m)::value, false>(q, v, value, gradient);
+        });
       else if (value != nullptr)
         *value = model().lagrangian(Vec<double>(Eigen::Map<const Vec<double>>(q, m_)),
                                     Vec<double>(Eigen::Map<const Vec<double>>(v, n_)));
@@ -92,46 +96,68 @@ class AutodiffLagrangian : public Lagrangian {
   double at(const double* q, const double* v, int k) const { return k < m_ ? q[k] : v[k - m_]; }
 
   // Calls f with tags (std::type_identity) of the first- and second-order scalar types for
-  // k = m + n: fixed-size
-  // where k is one of the common sizes, else the capacity-bounded dynamic ones.
+  // k = m + n, and m as a compile-time constant (Shape): fixed-size types where k is one of the
+  // common sizes, with m fixed too for the common shapes (R^1..R^3: m = n; SO(3): 9 + 3), so that
+  // every index of the first-order seeding is known at compile time; else the capacity-bounded
+  // dynamic types and m = Eigen::Dynamic (read at run time).
   template <class T>
   using Tag = std::type_identity<T>;
+  template <int M>
+  using Shape = std::integral_constant<int, M>;
   template <class F>
   void dispatch(F&& f) const {
     switch (m_ + n_) {
-      case 2: return f(Tag<FixedDual<2>>(), Tag<FixedDual2<2>>());
-      case 4: return f(Tag<FixedDual<4>>(), Tag<FixedDual2<4>>());
-      case 6: return f(Tag<FixedDual<6>>(), Tag<FixedDual2<6>>());
-      case 12: return f(Tag<FixedDual<12>>(), Tag<FixedDual2<12>>());
-      default: return f(Tag<Dual>(), Tag<Dual2>());
+      case 2: return common_shape<2, 1>(f);
+      case 4: return common_shape<4, 2>(f);
+      case 6: return common_shape<6, 3>(f);
+      case 12: return common_shape<12, 9>(f);
+      default: return f(Tag<Dual>(), Tag<Dual2>(), Shape<Eigen::Dynamic>());
     }
+  }
+  template <int K, int M, class F>
+  void common_shape(F& f) const {
+    if (m_ == M) return f(Tag<FixedDual<K>>(), Tag<FixedDual2<K>>(), Shape<M>());
+    return f(Tag<FixedDual<K>>(), Tag<FixedDual2<K>>(), Shape<Eigen::Dynamic>());
   }
 
   // L and its gradient by forward mode: one derivative direction per number of (q, v). For a
-  // fixed-size D the loop runs to the compile-time size, so that it unrolls and each seed
-  // e_i is stored whole (not a zero vector then one coefficient, which the next whole-vector
-  // load has to wait for).
+  // fixed-size D the loop runs to the compile-time size, so that it unrolls and each seed e_i is
+  // stored whole (not a zero vector then one coefficient, which the next whole-vector load has
+  // to wait for); with m fixed too (M >= 0) every index is a constant, and the compiler keeps the
+  // seeds in registers instead of storing and reloading them.
   // Without the value (WithValue false), what only L needs is dead code once the model is inlined
-  // (flatten: the model and Eigen's dual arithmetic are inlined here) (cos q of the pendulum's m g l cos q, whose derivative needs sin q alone): math functions are
-  // pure here, since varia builds with -fno-math-errno (the evaluator checks finiteness instead).
-  template <class D, bool WithValue>
-  [[gnu::noinline, gnu::flatten]] void first_order(const double* q, const double* v, double* value, double* gradient) const {
+  // (flatten: the model and Eigen's dual arithmetic are inlined here; noinline: the frame stays
+  // this function's, not evaluate's with every other path in it). Math functions are pure, since
+  // varia builds with -fno-math-errno (the evaluator checks finiteness instead), so that a model
+  // written c * cos(q) with a double c costs sin q alone (written T(c) * cos(q), the derivative
+  // multiplies c's zero derivatives by cos q, and IEEE arithmetic keeps that: sincos).
+  // The model is compiled for every common shape, also those it never runs with (an SO(3) model
+  // at m = 1, whose q(6) would read past the size): GCC's warnings of uninitialized reads there
+  // are about code that never runs.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+  template <class D, int M, bool WithValue>
+  [[gnu::noinline, gnu::flatten]] void first_order(const double* q, const double* v, double* value,
+                                                   double* gradient) const {
     constexpr int fixed = D::DerType::SizeAtCompileTime;
     const int k = fixed > 0 ? fixed : m_ + n_;
-    Vec<D> qd(m_), vd(n_);
+    const int m = M >= 0 ? M : m_;
+    Vec<D> qd(m), vd(k - m);
     for (int i = 0; i < k; ++i) {
-      D& z = i < m_ ? qd(i) : vd(i - m_);
-      z.value() = at(q, v, i);
+      D& z = i < m ? qd(i) : vd(i - m);
+      z.value() = i < m ? q[i] : v[i - m];
       z.derivatives() = D::DerType::Unit(k, i);
     }
     const D r = model().lagrangian(qd, vd);
     if constexpr (WithValue) *value = r.value();
     for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : 0.0;
   }
+#pragma GCC diagnostic pop
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).
   template <class D2>
-  [[gnu::noinline]] void second_order(const double* q, const double* v, double* value, double* gradient,
+  void second_order(const double* q, const double* v, double* value, double* gradient,
                     double* hessian) const {
     using D = typename D2::Scalar;
     using Inner = typename D::DerType;
