@@ -263,7 +263,7 @@ int main(int argc, char** argv) {
   varia::host::Registry registry(varia::host::Registry::search_path({}));
   std::vector<VariaMethod> methods;
   methods.push_back(make_varia(registry, "varia galerkin s=1, trapezoid (Stormer-Verlet)", galerkin_scene(1, "gauss-lobatto", 2)));
-  for (int s : {2, 3, 4})
+  for (int s : {2, 3, 4, 5, 6})
     methods.push_back(make_varia(registry, fmt::format("varia galerkin s={}, gauss-lobatto {}", s, s + 1),
                                  galerkin_scene(s, "gauss-lobatto", s + 1)));
   for (int s : {2, 3})

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "varia/core/compensated.hpp"
 
@@ -36,6 +37,19 @@ void check_control_times(const std::vector<double>& d) {
     if (!(d[i] > d[i - 1])) throw std::invalid_argument("control times must increase");
 }
 
+// f(std::integral_constant<int, N>{}) with N = n for n <= 4, N = Eigen::Dynamic otherwise: the
+// fixed-size instance of a member template, chosen once.
+template <class F>
+auto for_dimension(int n, F f) {
+  switch (n) {
+    case 1: return f(std::integral_constant<int, 1>{});
+    case 2: return f(std::integral_constant<int, 2>{});
+    case 3: return f(std::integral_constant<int, 3>{});
+    case 4: return f(std::integral_constant<int, 4>{});
+    default: return f(std::integral_constant<int, Eigen::Dynamic>{});
+  }
+}
+
 }  // namespace
 
 std::vector<double> equispaced_control_times(int degree) {
@@ -49,14 +63,9 @@ LagrangeBasis::LagrangeBasis(const std::vector<double>& times, const Quadrature&
     : control_times(times) {
   check_control_times(times);
   const int r = quadrature.size(), count = static_cast<int>(times.size());
-  phi.resize(r, count);
-  dphi.resize(r, count);
-  Eigen::VectorXd l(count), dl(count);
-  for (int i = 0; i < r; ++i) {
-    lagrange(times, quadrature.nodes()[i], l.data(), dl.data());
-    phi.row(i) = l;
-    dphi.row(i) = dl;
-  }
+  phi.resize(count, r);
+  dphi.resize(count, r);
+  for (int i = 0; i < r; ++i) lagrange(times, quadrature.nodes()[i], phi.col(i).data(), dphi.col(i).data());
 }
 
 Eigen::VectorXd LagrangeBasis::at(double tau) const {
@@ -122,15 +131,10 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   // The forces' Jacobian [df/dq, df/dv]: rows are equations (weighted by l_nu, never by v).
   for (std::size_t e = 0; e < forces_.rows().size(); ++e)
     entries_.push_back(Entry{forces_.rows()[e], forces_.cols()[e] % n_, false, forces_.cols()[e] >= n_});
-  if (explicit_form_applies(quadrature)) {
-    switch (n_) {
-      case 1: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<1>; break;
-      case 2: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<2>; break;
-      case 3: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<3>; break;
-      case 4: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<4>; break;
-      default: explicit_advance_ = &GalerkinDiscreteLagrangian::explicit_advance<Eigen::Dynamic>;
-    }
-  }
+  action_ = for_dimension(n_, [](auto N) -> ActionFunction { return &GalerkinDiscreteLagrangian::action_for<decltype(N)::value>; });
+  if (explicit_form_applies(quadrature))
+    explicit_advance_ = for_dimension(
+        n_, [](auto N) -> AdvanceFunction { return &GalerkinDiscreteLagrangian::explicit_advance<decltype(N)::value>; });
 }
 
 const EvaluationCounters& GalerkinDiscreteLagrangian::evaluations() const {
@@ -224,15 +228,33 @@ void GalerkinDiscreteLagrangian::advance(double* q, double* p, double h, long st
 }
 
 // q_i = q^0 + sum_nu l_nu(c_i) (q^nu - q^0) (sum_nu l_nu = 1), v_i = (1/h) sum_nu l'_nu(c_i) (q^nu - q^0).
+// Plain loops over contiguous arrays: at small n a matrix-vector product's setup would cost more
+// than its arithmetic.
+template <int N>
 void GalerkinDiscreteLagrangian::interpolate(int i, double h) {
-  q_ = origin_;
-  q_.noalias() += points_ * basis_.phi.row(i).transpose();
-  v_.noalias() = points_ * basis_.dphi.row(i).transpose();
-  v_ /= h;
+  const int n = N == Eigen::Dynamic ? n_ : N;
+  const double* __restrict a = basis_.phi.col(i).data();
+  const double* __restrict da = basis_.dphi.col(i).data();
+  const double* __restrict points = points_.data();
+  double* __restrict q = q_.data();
+  double* __restrict v = v_.data();
+  for (int r = 0; r < n; ++r) {
+    q[r] = 0.0;
+    v[r] = 0.0;
+  }
+  for (int nu = 0; nu <= s_; ++nu)
+    for (int r = 0; r < n; ++r) {
+      q[r] += a[nu] * points[nu * n + r];
+      v[r] += da[nu] * points[nu * n + r];
+    }
+  for (int r = 0; r < n; ++r) {
+    q[r] += origin_[r];
+    v[r] /= h;
+  }
 }
 
 double GalerkinDiscreteLagrangian::weight(int i, int nu, bool by_v, double h) const {
-  return by_v ? basis_.dphi(i, nu) / h : basis_.phi(i, nu);
+  return by_v ? basis_.dphi(nu, i) / h : basis_.phi(nu, i);
 }
 
 // S = h sum_i b_i L(q_i, v_i), q_i = sum_nu l_nu(c_i) q^nu, v_i = (1/h) sum_nu l'_nu(c_i) q^nu
@@ -242,8 +264,9 @@ double GalerkinDiscreteLagrangian::weight(int i, int nu, bool by_v, double h) co
 //                                + l'_nu l'_mu L_vv / h).
 // With the gradient, impulse_ = h sum_i b_i (L_q + f)(c_i) = sum_nu (dS/dq^nu + f_d^nu), since
 // sum_nu l_nu = 1 and sum_nu l'_nu = 0: the momentum change of the step (see step()).
-double GalerkinDiscreteLagrangian::action(double h, Order order, bool forced) {
-  const int n = n_;
+template <int N>
+double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced) {
+  const int n = N == Eigen::Dynamic ? n_ : N;
   const bool sparse = lagrangian_.sparse();
   double S = 0.0;
   if (order != Order::value) {
@@ -252,9 +275,9 @@ double GalerkinDiscreteLagrangian::action(double h, Order order, bool forced) {
   }
   if (order == Order::hessian && sparse) sparse_.matrix.coeffs().setZero();
   if (order == Order::hessian && !sparse) hessian_.setZero();
-  for (int i = 0; i < basis_.phi.rows(); ++i) {
+  for (int i = 0; i < basis_.phi.cols(); ++i) {
     if (weights_[i] == 0.0) continue;
-    interpolate(i, h);
+    interpolate<N>(i, h);
     double L = 0.0;
     if (order == Order::hessian && sparse)
       L = lagrangian_.sparse_hessian(q_.data(), v_.data(), grad_.data(), sparse_values_.data());
@@ -271,37 +294,51 @@ double GalerkinDiscreteLagrangian::action(double h, Order order, bool forced) {
     if (forced) add_forces(i, h, order);
     if (order == Order::hessian && sparse)
       add_sparse_entries(i, h, 0, sparse_values_.data(), static_cast<int>(sparse_values_.size()), h * b);
-    for (int nu = 0; nu <= s_; ++nu) {
-      const double a = basis_.phi(i, nu), da = basis_.dphi(i, nu);
-      gradient_.segment(nu * n, n) += b * (h * a * grad_.head(n) + da * grad_.tail(n));
-    }
-    if (order == Order::hessian && !sparse) add_hessian(i, h, b);
+    add_gradient<N>(i, h, b);
+    if (order == Order::hessian && !sparse) add_hessian<N>(i, h, b);
   }
   return S;
 }
 
+// gradient_ (nu n + r) += b (h l_nu L_q + l'_nu L_v)(r) at node i (see action()).
+template <int N>
+void GalerkinDiscreteLagrangian::add_gradient(int i, double h, double b) {
+  const int n = N == Eigen::Dynamic ? n_ : N;
+  const double* __restrict a = basis_.phi.col(i).data();
+  const double* __restrict da = basis_.dphi.col(i).data();
+  const double* __restrict dL = grad_.data();  // [L_q; L_v]
+  double* __restrict gradient = gradient_.data();
+  for (int nu = 0; nu <= s_; ++nu) {
+    const double x = b * h * a[nu], y = b * da[nu];
+    for (int r = 0; r < n; ++r) gradient[nu * n + r] += x * dL[r] + y * dL[n + r];
+  }
+}
+
 // hessian_(nu n + r, mu n + c) += b (l_nu (h l_mu L_qq + l'_mu L_qv) + l'_nu (l_mu L_vq + l'_mu L_vv / h))(r, c)
 // at node i: the same sum as above, factored by column so that each entry costs two products
-// (this runs (s+1)^2 n^2 times per node and Newton iteration).
+// (this runs (s+1)^2 n^2 times per node and Newton iteration). Column (mu, c) of the update is
+// l_nu g_q + l'_nu g_v over (nu, r) for the column's two n-vectors g = column_.
+template <int N>
 void GalerkinDiscreteLagrangian::add_hessian(int i, double h, double b) {
-  const int n = n_, k = 2 * n_;
-  const double* H = hess_.data();  // the 2n x 2n Hessian of L in (q, v), column-major
-  double* column_q = column_.data();
-  double* column_v = column_.data() + n;
+  const int n = N == Eigen::Dynamic ? n_ : N, k = 2 * n, size = (s_ + 1) * n;
+  const double* __restrict H = hess_.data();  // the 2n x 2n Hessian of L in (q, v), column-major
+  const double* __restrict a = basis_.phi.col(i).data();
+  const double* __restrict da = basis_.dphi.col(i).data();
+  double* __restrict column_q = column_.data();
+  double* __restrict column_v = column_.data() + n;
+  double* __restrict hessian = hessian_.data();
   for (int mu = 0; mu <= s_; ++mu) {
-    const double c = basis_.phi(i, mu), dc = basis_.dphi(i, mu);
+    const double cq = b * h * a[mu], dcq = b * da[mu], cv = b * a[mu], dcv = b * da[mu] / h;
     for (int col = 0; col < n; ++col) {
       const double* by_q = H + col * k;        // d/dq_col of [L_q; L_v]
       const double* by_v = H + (n + col) * k;  // d/dv_col of [L_q; L_v]
       for (int r = 0; r < n; ++r) {
-        column_q[r] = b * (h * c * by_q[r] + dc * by_v[r]);
-        column_v[r] = b * (c * by_q[n + r] + dc / h * by_v[n + r]);
+        column_q[r] = cq * by_q[r] + dcq * by_v[r];
+        column_v[r] = cv * by_q[n + r] + dcv * by_v[n + r];
       }
-      double* target = hessian_.data() + (mu * n + col) * hessian_.rows();
-      for (int nu = 0; nu <= s_; ++nu) {
-        const double a = basis_.phi(i, nu), da = basis_.dphi(i, nu);
-        for (int r = 0; r < n; ++r) target[nu * n + r] += a * column_q[r] + da * column_v[r];
-      }
+      double* target = hessian + (mu * n + col) * size;
+      for (int nu = 0; nu <= s_; ++nu)
+        for (int r = 0; r < n; ++r) target[nu * n + r] += a[nu] * column_q[r] + da[nu] * column_v[r];
     }
   }
 }
@@ -313,7 +350,7 @@ void GalerkinDiscreteLagrangian::add_forces(int i, double h, Order order) {
   forces_.evaluate(t_ + nodes_[i] * h, q_.data(), v_.data(), f_.data(),
                    jacobian ? force_values_.data() : nullptr);
   const double w = h * weights_[i];
-  for (int nu = 0; nu <= s_; ++nu) gradient_.segment(nu * n_, n_) += w * basis_.phi(i, nu) * f_;
+  for (int nu = 0; nu <= s_; ++nu) gradient_.segment(nu * n_, n_) += w * basis_.phi(nu, i) * f_;
   impulse_ += w * f_;
   if (!jacobian) return;
   const int first = static_cast<int>(entries_.size() - force_values_.size());

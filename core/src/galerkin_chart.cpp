@@ -84,8 +84,8 @@ void LieGroupGalerkinDiscreteLagrangian::check(Status status) const {
 // carried to the unknowns (eta, xi^1..xi^s) by xi = sum_nu l_nu(c_i) xi^nu and
 // xi_dot = sum_nu l'_nu(c_i) xi^nu / h (paper, sec. 2: the interpolant in the Lie algebra).
 double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, double h, bool with_hessian) {
-  node_xi_.noalias() = xi_ * basis_.phi.row(i).transpose();
-  node_rate_.noalias() = xi_ * basis_.dphi.row(i).transpose() / h;
+  node_xi_.noalias() = xi_ * basis_.phi.col(i);
+  node_rate_.noalias() = xi_ * basis_.dphi.col(i) / h;
   const int n = n_;
   check(manifold_.chart_jets(q0, node_xi_.data(), node_rate_.data(),
                              reduced_ ? nullptr : point_.data(), velocity_.data()));
@@ -110,7 +110,7 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
   const double w = h * weights_(i);
   const auto c = [&](int a, int beta) {
     if (beta == 0) return a == 0 ? 1.0 : 0.0;
-    return a == 1 ? basis_.phi(i, beta) : a == 2 ? basis_.dphi(i, beta) / h : 0.0;
+    return a == 1 ? basis_.phi(beta, i) : a == 2 ? basis_.dphi(beta, i) / h : 0.0;
   };
   for (int beta = 0; beta <= s_; ++beta)
     for (int a = 0; a < 3; ++a) {

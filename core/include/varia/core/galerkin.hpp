@@ -29,7 +29,8 @@
 namespace varia {
 
 // Lagrange basis through the control times, evaluated at the quadrature nodes:
-// phi(i, nu) = l_nu(c_i), dphi(i, nu) = l'_nu(c_i) (derivative in tau in [0, 1]).
+// phi(nu, i) = l_nu(c_i), dphi(nu, i) = l'_nu(c_i) (derivative in tau in [0, 1]); column i holds
+// node i's values, contiguous for the loops over control points.
 struct LagrangeBasis {
   LagrangeBasis(const std::vector<double>& control_times, const Quadrature& quadrature);
   Eigen::MatrixXd phi, dphi;
@@ -70,11 +71,21 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // in points_, with its gradient dS/dq^nu in gradient_ and Hessian in hessian_ (sparse: in
   // sparse_.matrix) up to `order`; with `forced`, f_d^nu is added to gradient_ and its Jacobian to
   // the Hessian.
-  double action(double h, Order order, bool forced = false);
+  double action(double h, Order order, bool forced = false) { return (this->*action_)(h, order, forced); }
+  // action() compiled for N = n (the per-node loops over control points and coordinates unrolled,
+  // no loop set up for a handful of numbers) when n <= 4, for Eigen::Dynamic otherwise; chosen
+  // once, in action_.
+  template <int N>
+  double action_for(double h, Order order, bool forced);
+  using ActionFunction = double (GalerkinDiscreteLagrangian::*)(double, Order, bool);
   // The interpolant at quadrature node i: q_, v_.
+  template <int N>
   void interpolate(int i, double h);
   void add_forces(int i, double h, Order order);
-  // The dense Hessian's terms of node i with weight b (see action()).
+  // The gradient's and the dense Hessian's terms of node i with weight b (see action()).
+  template <int N>
+  void add_gradient(int i, double h, double b);
+  template <int N>
   void add_hessian(int i, double h, double b);
   // dq_i/dq^nu = l_nu(c_i), dv_i/dq^nu = l'_nu(c_i)/h: the weight of an entry's row or column.
   double weight(int i, int nu, bool by_v, double h) const;
@@ -152,6 +163,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
     bool analyzed = false;
   };
   SparseJacobian sparse_;
+  ActionFunction action_ = nullptr;
   // The explicit form: its steps (null when it does not apply), endpoint weights, M and M^{-1},
   // and dL/dq at the last q1 (reused as dL/dq at the next q0: one gradient evaluation per step);
   // velocity_ is the dynamic-size form's workspace.
