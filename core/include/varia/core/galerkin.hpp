@@ -165,12 +165,12 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   SparseJacobian sparse_;
   ActionFunction action_ = nullptr;
   // The explicit form: its steps (null when it does not apply), endpoint weights, M and M^{-1},
-  // and dL/dq at the last q1 (reused as dL/dq at the next q0: one gradient evaluation per step);
-  // velocity_ is the dynamic-size form's workspace.
+  // and, at the last (q1, p1) with step previous_h_, dL/dq and the increment h v (reused by a step
+  // from there: one gradient evaluation per step).
   AdvanceFunction explicit_advance_ = nullptr;
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;
-  Eigen::VectorXd force_, last_q_;
+  Eigen::VectorXd force_, increment_, last_q_, last_p_;
   bool has_force_ = false;
 };
 

@@ -1,0 +1,98 @@
+// "The stepping loop allocates nothing per step": every heap allocation of this process is counted
+// (malloc is interposed: Eigen's dynamic matrices and operator new both end there), and the
+// Galerkin maps' steps are run between two readings of the count, after a first step has sized
+// the workspace. One case where it must not hold: resizing a dynamic vector is counted.
+#include <doctest/doctest.h>
+
+#include <Eigen/Core>
+#include <cstddef>
+
+#include "core/fixtures.hpp"
+#include "varia/core/galerkin.hpp"
+
+extern "C" void* __libc_malloc(std::size_t size);  // glibc's own malloc, always exported
+extern "C" void* __libc_calloc(std::size_t count, std::size_t size);
+extern "C" void* __libc_realloc(void* pointer, std::size_t size);
+
+namespace {
+long allocations = 0;
+}  // namespace
+
+extern "C" void* malloc(std::size_t size) {
+  ++allocations;
+  return __libc_malloc(size);
+}
+extern "C" void* calloc(std::size_t count, std::size_t size) {
+  ++allocations;
+  return __libc_calloc(count, size);
+}
+extern "C" void* realloc(void* pointer, std::size_t size) {
+  ++allocations;
+  return __libc_realloc(pointer, size);
+}
+
+using namespace varia;
+using namespace varia::testing;
+
+namespace {
+
+// The allocations made by f().
+template <class F>
+long allocations_of(F&& f) {
+  const long before = allocations;
+  f();
+  return allocations - before;
+}
+
+// n uncoupled unit pendulums declaring their mass matrix (the explicit form applies at degree 1).
+struct UnitPendulums : sdk::AutodiffLagrangian<UnitPendulums> {
+  explicit UnitPendulums(int n) : sdk::AutodiffLagrangian<UnitPendulums>(n, n), n_(n) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::cos;
+    T L = T(0.0);
+    for (int i = 0; i < n_; ++i) L += 0.5 * v(i) * v(i) + cos(q(i));
+    return L;
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    Eigen::Map<Eigen::MatrixXd>(mass, n_, n_).setIdentity();
+    return true;
+  }
+  int n_;
+};
+
+// 50 steps by step() and 50 by advance(), after one step that sizes everything.
+long allocations_of_steps(GalerkinDiscreteLagrangian& map, int n) {
+  Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), p = Eigen::VectorXd::Zero(n), q1(n), p1(n);
+  map.step(q.data(), p.data(), 0.1, q1.data(), p1.data());
+  return allocations_of([&] {
+    for (int k = 0; k < 50; ++k) {
+      map.step(q1.data(), p1.data(), 0.1, q.data(), p.data());
+      q.swap(q1);
+      p.swap(p1);
+    }
+    map.advance(q.data(), p.data(), 0.1, 50, q1.data(), p1.data());
+  });
+}
+
+}  // namespace
+
+TEST_CASE("allocations are counted: resizing a dynamic vector allocates") {
+  Eigen::VectorXd v;
+  CHECK(allocations_of([&] { v.resize(1000); }) >= 1);
+}
+
+TEST_CASE("galerkin steps allocate nothing: explicit form (n = 1, 5) and Newton (n = 1, 5)") {
+  auto trapezoid_rule = trapezoid();
+  auto lobatto = lobatto3();
+  for (int n : {1, 5}) {
+    CAPTURE(n);
+    FlatSpace space(n);
+    UnitPendulums explicit_form(n);
+    GalerkinDiscreteLagrangian verlet(space, explicit_form, trapezoid_rule, equispaced_control_times(1), {});
+    CHECK(allocations_of_steps(verlet, n) == 0);
+    UnitPendulums newton_form(n);
+    GalerkinDiscreteLagrangian galerkin(space, newton_form, lobatto, equispaced_control_times(2), {});
+    CHECK(allocations_of_steps(galerkin, n) == 0);
+  }
+}
