@@ -38,15 +38,23 @@ struct Context {
 json prediction(const std::optional<bool>& p) { return p ? json(*p) : json(nullptr); }
 json prediction(const std::optional<int>& p) { return p ? json(*p) : json(nullptr); }
 
+// A check of `name` with its prediction, not yet measured.
+PropertyCheck check_of(const char* name, json predicted) {
+  PropertyCheck c;
+  c.name = name;
+  c.predicted = std::move(predicted);
+  return c;
+}
+
 PropertyCheck not_measured(const char* name, json predicted, const char* why) {
-  PropertyCheck c{name, std::move(predicted)};
+  PropertyCheck c = check_of(name, std::move(predicted));
   c.note = why;
   return c;
 }
 
 PropertyCheck residual_check(const char* name, json predicted, double residual, double tolerance,
                              std::string note) {
-  PropertyCheck c{name, std::move(predicted)};
+  PropertyCheck c = check_of(name, std::move(predicted));
   c.measured = residual;
   c.tolerance = tolerance;
   c.holds = residual <= tolerance;
@@ -198,7 +206,7 @@ std::string fit_note(const OrderFit& fit, const std::string& what) {
 
 PropertyCheck order_check(const char* name, const std::optional<int>& predicted, const OrderFit& fit,
                           double offset, const std::string& what) {
-  PropertyCheck c{name, prediction(predicted)};
+  PropertyCheck c = check_of(name, prediction(predicted));
   c.tolerance = kOrderSlack;
   c.note = fit_note(fit, what);
   if (fit.used < 2) {
