@@ -42,12 +42,26 @@ struct Jet2 {
 namespace jet {
 
 // f(a), given f(a.value) and f', f'' there: g = f' a_g, H = f' a_H + f'' a_g a_g^T.
+// Plain loops over the n (at most kMaxJetVariables) variables, one pass over the Hessian: jets
+// are small, and a generic product's setup would cost more than its arithmetic.
 inline Jet2 unary(const Jet2& a, double f, double d1, double d2) {
   Jet2 r(f);
   if (a.constant()) return r;
-  r.gradient = d1 * a.gradient;
-  r.hessian = d1 * a.hessian;
-  if (d2 != 0.0) r.hessian.noalias() += d2 * a.gradient * a.gradient.transpose();
+  const int n = static_cast<int>(a.gradient.size());
+  r.gradient.resize(n);
+  r.hessian.resize(n, n);
+  const double* __restrict g = a.gradient.data();
+  const double* __restrict H = a.hessian.data();
+  double* __restrict rg = r.gradient.data();
+  double* __restrict rH = r.hessian.data();
+  for (int i = 0; i < n; ++i) rg[i] = d1 * g[i];
+  for (int j = 0; j < n; ++j) {
+    const double c = d2 * g[j];
+    if (d2 == 0.0)  // no outer product: 0 * an infinite gradient would make NaN
+      for (int i = 0; i < n; ++i) rH[j * n + i] = d1 * H[j * n + i];
+    else
+      for (int i = 0; i < n; ++i) rH[j * n + i] = d1 * H[j * n + i] + c * g[i];
+  }
   return r;
 }
 
@@ -58,20 +72,36 @@ struct Partials {
 
 // F(a, b) by the second-order chain rule:
 // g = F_a a_g + F_b b_g,
-// H = F_a a_H + F_b b_H + F_aa a_g a_g^T + F_ab (a_g b_g^T + b_g a_g^T) + F_bb b_g b_g^T.
+// H = F_a a_H + F_b b_H + F_aa a_g a_g^T + F_ab (a_g b_g^T + b_g a_g^T) + F_bb b_g b_g^T
+//   = F_a a_H + F_b b_H + u a_g^T + w b_g^T,  u = F_aa a_g + F_ab b_g,  w = F_ab a_g + F_bb b_g,
+// in one pass over H (the second-order terms only where a second partial is not zero).
 inline Jet2 binary(const Jet2& a, const Jet2& b, double f, const Partials& d) {
   if (a.constant()) return unary(b, f, d.b, d.bb);
   if (b.constant()) return unary(a, f, d.a, d.aa);
   assert(a.gradient.size() == b.gradient.size());
+  const int n = static_cast<int>(a.gradient.size());
   Jet2 r(f);
-  r.gradient = d.a * a.gradient + d.b * b.gradient;
-  r.hessian = d.a * a.hessian + d.b * b.hessian;
-  if (d.aa != 0.0) r.hessian.noalias() += d.aa * a.gradient * a.gradient.transpose();
-  if (d.bb != 0.0) r.hessian.noalias() += d.bb * b.gradient * b.gradient.transpose();
-  if (d.ab != 0.0) {
-    r.hessian.noalias() += d.ab * a.gradient * b.gradient.transpose();
-    r.hessian.noalias() += d.ab * b.gradient * a.gradient.transpose();
+  r.gradient.resize(n);
+  r.hessian.resize(n, n);
+  const double* __restrict ga = a.gradient.data();
+  const double* __restrict gb = b.gradient.data();
+  const double* __restrict Ha = a.hessian.data();
+  const double* __restrict Hb = b.hessian.data();
+  double* __restrict rg = r.gradient.data();
+  double* __restrict rH = r.hessian.data();
+  for (int i = 0; i < n; ++i) rg[i] = d.a * ga[i] + d.b * gb[i];
+  if (d.aa == 0.0 && d.ab == 0.0 && d.bb == 0.0) {
+    for (int k = 0; k < n * n; ++k) rH[k] = d.a * Ha[k] + d.b * Hb[k];
+    return r;
   }
+  double u[kMaxJetVariables], w[kMaxJetVariables];
+  for (int i = 0; i < n; ++i) {
+    u[i] = d.aa * ga[i] + d.ab * gb[i];
+    w[i] = d.ab * ga[i] + d.bb * gb[i];
+  }
+  for (int j = 0; j < n; ++j)
+    for (int i = 0; i < n; ++i)
+      rH[j * n + i] = d.a * Ha[j * n + i] + d.b * Hb[j * n + i] + u[i] * ga[j] + w[i] * gb[j];
   return r;
 }
 

@@ -15,6 +15,8 @@
 #include <cmath>
 #include <type_traits>
 
+#include "varia/core/jet.hpp"
+
 namespace varia::so3 {
 
 template <class T>
@@ -55,6 +57,20 @@ T series(const T& x, const double (&c)[N]) {
   T sum = T(c[N - 1]);
   for (std::size_t k = N - 1; k-- > 0;) sum = sum * x + T(c[k]);
   return sum;
+}
+
+// The same series of a jet: one chain-rule step (jet::unary) with the value and the first two
+// derivatives of the polynomial summed in double at x's value (Horner's rule for p, p', p''),
+// instead of 2(N-1) jet operations with their Hessians.
+template <std::size_t N>
+Jet2 series(const Jet2& x, const double (&c)[N]) {
+  double p = c[N - 1], d1 = 0.0, d2 = 0.0;
+  for (std::size_t k = N - 1; k-- > 0;) {
+    d2 = d2 * x.value + 2.0 * d1;
+    d1 = d1 * x.value + p;
+    p = p * x.value + c[k];
+  }
+  return jet::unary(x, p, d1, d2);
 }
 
 // sin(theta)/theta.
