@@ -44,23 +44,6 @@ long allocations_of(F&& f) {
   return allocations - before;
 }
 
-// n uncoupled unit pendulums declaring their mass matrix (the explicit form applies at degree 1).
-struct UnitPendulums : sdk::AutodiffLagrangian<UnitPendulums> {
-  explicit UnitPendulums(int n) : sdk::AutodiffLagrangian<UnitPendulums>(n, n), n_(n) {}
-  template <class T>
-  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
-    using std::cos;
-    T L = T(0.0);
-    for (int i = 0; i < n_; ++i) L += 0.5 * v(i) * v(i) + cos(q(i));
-    return L;
-  }
-  bool constant_mass_matrix(double* mass) const noexcept override {
-    Eigen::Map<Eigen::MatrixXd>(mass, n_, n_).setIdentity();
-    return true;
-  }
-  int n_;
-};
-
 // 50 steps by step() and 50 by advance(), after one step that sizes everything.
 long allocations_of_steps(GalerkinDiscreteLagrangian& map, int n) {
   Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), p = Eigen::VectorXd::Zero(n), q1(n), p1(n);
@@ -88,10 +71,10 @@ TEST_CASE("galerkin steps allocate nothing: explicit form (n = 1, 5) and Newton 
   for (int n : {1, 5}) {
     CAPTURE(n);
     FlatSpace space(n);
-    UnitPendulums explicit_form(n);
+    Pendulums explicit_form(n);
     GalerkinDiscreteLagrangian verlet(space, explicit_form, trapezoid_rule, equispaced_control_times(1), {});
     CHECK(allocations_of_steps(verlet, n) == 0);
-    UnitPendulums newton_form(n);
+    Pendulums newton_form(n);
     GalerkinDiscreteLagrangian galerkin(space, newton_form, lobatto, equispaced_control_times(2), {});
     CHECK(allocations_of_steps(galerkin, n) == 0);
   }

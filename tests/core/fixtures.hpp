@@ -62,6 +62,24 @@ struct Pendulum : sdk::AutodiffLagrangian<Pendulum> {
   }
 };
 
+// n uncoupled pendulums with masses 1..n, declaring their constant mass matrix: at degree 1 the
+// Galerkin explicit form applies, at a fixed size (n <= 4) or the dynamic size (n > 4).
+struct Pendulums : sdk::AutodiffLagrangian<Pendulums> {
+  explicit Pendulums(int n) : sdk::AutodiffLagrangian<Pendulums>(n, n), n_(n) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::cos;
+    T L = T(0.0);
+    for (int i = 0; i < n_; ++i) L += (0.5 * (i + 1)) * v(i) * v(i) + (i + 1.0) * cos(q(i));
+    return L;
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    Eigen::Map<Eigen::MatrixXd>(mass, n_, n_) = Eigen::VectorXd::LinSpaced(n_, 1, n_).asDiagonal();
+    return true;
+  }
+  int n_;
+};
+
 // SO(3) in process (varia/core/so3.hpp): points are row-major rotation matrices.
 struct Rotations : Manifold {
   int point_size() const noexcept override { return 9; }

@@ -105,24 +105,6 @@ TEST_CASE("galerkin explicit form for a constant mass matrix agrees with the New
   CHECK(newton.solver_statistics().max_iterations >= 1);
 }
 
-// n uncoupled pendulums with masses 1..n, declaring their constant mass matrix: the explicit form
-// at a fixed size (n <= 4) and at the dynamic size (n = 5).
-struct Pendulums : sdk::AutodiffLagrangian<Pendulums> {
-  explicit Pendulums(int n) : sdk::AutodiffLagrangian<Pendulums>(n, n), n_(n) {}
-  template <class T>
-  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
-    using std::cos;
-    T L = T(0.0);
-    for (int i = 0; i < n_; ++i) L += (0.5 * (i + 1)) * v(i) * v(i) + (i + 1.0) * cos(q(i));
-    return L;
-  }
-  bool constant_mass_matrix(double* mass) const noexcept override {
-    Eigen::Map<Eigen::MatrixXd>(mass, n_, n_) = Eigen::VectorXd::LinSpaced(n_, 1, n_).asDiagonal();
-    return true;
-  }
-  int n_;
-};
-
 // advance() (the loop varia cost and the benchmarks time) must be the steps of step(), to the
 // bit: the explicit form's register loop at n = 1, 2 and 5, and the default loop (Newton) for a
 // Lagrangian that declares no constant mass matrix.
