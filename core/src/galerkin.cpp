@@ -182,7 +182,7 @@ bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
 // three shorter, and the loop's speed is that chain's latency (bench/README.md). The increment
 // and dL/dq are kept for the next call: one that continues from this one's output (q, p and h
 // as left) takes the same steps as one call for both, to the bit, and evaluates no gradient at q.
-// N is n, or Dynamic. For a fixed N the state (q, v, dL/dq) is held in local fixed-size vectors
+// N is n, or Dynamic. For a fixed N the state (q, h v, dL/dq) is held in local fixed-size vectors
 // across the steps, and the plugin reads q and writes [dL/dq, dL/dv] in one small local array
 // (`io`): a step is a few registers' arithmetic and one plugin call. (With the plugin's input and
 // output in the class's heap vectors the same loop took 40 ns a step instead of 29 on the
@@ -192,6 +192,7 @@ template <int N>
 void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h, long steps) {
   using Vector = Eigen::Matrix<double, N, 1>;
   using Matrix = Eigen::Matrix<double, N, N>;
+  if (steps <= 0) return;  // (q, p) as given, not p formed again from the increment
   const Eigen::Map<const Matrix> mass(mass_matrix_.data(), n_, n_), inverse(inverse_mass_.data(), n_, n_);
   Eigen::Map<Vector> position(q, n_), momentum(p, n_), force(force_.data(), n_), increment(increment_.data(), n_),
       last_q(last_q_.data(), n_), last_p(last_p_.data(), n_);
