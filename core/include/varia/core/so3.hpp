@@ -233,32 +233,88 @@ T orthogonality_error(const Matrix3<T>& R) {
   return (Matrix3<T>::Identity() - R.transpose() * R).norm();
 }
 
+// The value, first and second derivatives of the 3 x 3 matrix function M(w) from jets of it in
+// the 3 variables w: value, d[l] = dM/dw_l, dd[l][m] = d2M/dw_l dw_m.
+struct MatrixJet3 {
+  Matrix3<double> value, d[3], dd[3][3];
+  explicit MatrixJet3(const Matrix3<Jet2>& M) {
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) {
+        value(r, c) = M(r, c).value;
+        for (int l = 0; l < 3; ++l) {
+          d[l](r, c) = M(r, c).constant() ? 0.0 : M(r, c).gradient(l);
+          for (int m = 0; m < 3; ++m) dd[l][m](r, c) = M(r, c).constant() ? 0.0 : M(r, c).hessian(l, m);
+        }
+      }
+  }
+};
+
+// A jet in 6 variables with its value only; the caller fills gradient and Hessian.
+inline Jet2 jet6(double value) {
+  Jet2 jet(value);
+  jet.gradient.resize(6);
+  jet.hessian.resize(6, 6);
+  return jet;
+}
+
 // The natural chart at R0 to second order (Manifold::chart_jets; paper, sec. 2 "Natural charts"):
 // R0 exp(eta) exp(xi) at eta = 0 as 9 row-major jets in the variables (eta, xi), and the
 // left-trivialized velocity dexp_{-xi}(xi_dot) as 3 jets in (xi, xi_dot). Either output may be
-// null. Jet is a second-order jet type with Jet::variable(value, count, index) (jet.hpp).
-template <class Jet>
-void chart_jets(const double* R0, const double* xi, const double* xi_dot, Jet* point, Jet* velocity) {
+// null.
+// Only exp(xi) and dexp_{-xi} are taken at jets, in the 3 variables xi; the rest is assembled from
+// their derivatives with double 3 x 3 products (jet arithmetic in all 6 variables did about 400
+// operations on 6 x 6 Hessians per call):
+//  - eta enters through exp(eta) = I + hat(eta) + hat(eta)^2/2 + O(|eta|^3), so with E = exp(xi),
+//    B = R0, H_k = hat(e_k): dR/deta_k = B H_k E, d2R/deta_k deta_l = B (H_k H_l + H_l H_k)/2 E,
+//    d2R/deta_k dxi_l = B H_k dE/dxi_l, and the xi derivatives are B's multiples of E's;
+//  - xi_dot enters linearly in Omega = D xi_dot, D = dexp_{-xi}: dOmega/dxi_dot_l = D e_l,
+//    d2Omega/dxi dxi_dot_l = dD/dxi e_l, d2Omega/dxi_dot^2 = 0.
+inline void chart_jets(const double* R0, const double* xi, const double* xi_dot, Jet2* point, Jet2* velocity) {
+  Vector3<Jet2> w;
+  for (int k = 0; k < 3; ++k) w(k) = Jet2::variable(xi[k], 3, k);
   if (point != nullptr) {
-    Vector3<Jet> eta, w;
+    const MatrixJet3 E(exp(w));
+    const Matrix3<double> B = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R0);
+    Matrix3<double> BH[3];
+    for (int k = 0; k < 3; ++k) BH[k] = B * hat(Vector3<double>(Vector3<double>::Unit(k)));
+    Matrix3<double> by[6], by2[6][6];  // the derivatives in the 6 variables (eta, xi)
     for (int k = 0; k < 3; ++k) {
-      eta(k) = Jet::variable(0.0, 6, k);
-      w(k) = Jet::variable(xi[k], 6, 3 + k);
+      by[k] = BH[k] * E.value;
+      by[3 + k] = B * E.d[k];
+      for (int l = 0; l < 3; ++l) {
+        by2[k][l] = (BH[k] * hat(Vector3<double>(Vector3<double>::Unit(l))) +
+                     BH[l] * hat(Vector3<double>(Vector3<double>::Unit(k)))) * E.value / 2.0;
+        by2[k][3 + l] = BH[k] * E.d[l];
+        by2[3 + l][k] = by2[k][3 + l];
+        by2[3 + k][3 + l] = B * E.dd[k][l];
+      }
     }
-    const Matrix3<Jet> base = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R0)
-                                  .template cast<Jet>();
-    const Matrix3<Jet> R = base * exp(eta) * exp(w);
+    const Matrix3<double> R = B * E.value;
     for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) point[3 * r + c] = R(r, c);
+      for (int c = 0; c < 3; ++c) {
+        Jet2& jet = point[3 * r + c] = jet6(R(r, c));
+        for (int a = 0; a < 6; ++a) {
+          jet.gradient(a) = by[a](r, c);
+          for (int b = 0; b < 6; ++b) jet.hessian(a, b) = by2[a][b](r, c);
+        }
+      }
   }
   if (velocity != nullptr) {
-    Vector3<Jet> w, rate;
-    for (int k = 0; k < 3; ++k) {
-      w(k) = Jet::variable(xi[k], 6, k);
-      rate(k) = Jet::variable(xi_dot[k], 6, 3 + k);
+    const MatrixJet3 D(dexp(Vector3<Jet2>(-w)));
+    const Eigen::Map<const Vector3<double>> rate(xi_dot);
+    const Vector3<double> omega = D.value * rate;
+    for (int i = 0; i < 3; ++i) {
+      Jet2& jet = velocity[i] = jet6(omega(i));
+      jet.hessian.setZero();
+      for (int k = 0; k < 3; ++k) {
+        jet.gradient(k) = D.d[k].row(i).dot(rate);
+        jet.gradient(3 + k) = D.value(i, k);
+        for (int m = 0; m < 3; ++m) {
+          jet.hessian(k, m) = D.dd[k][m].row(i).dot(rate);
+          jet.hessian(k, 3 + m) = jet.hessian(3 + m, k) = D.d[k](i, m);
+        }
+      }
     }
-    const Vector3<Jet> omega = dexp(Vector3<Jet>(-w)) * rate;
-    for (int k = 0; k < 3; ++k) velocity[k] = omega(k);
   }
 }
 
