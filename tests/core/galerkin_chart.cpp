@@ -82,6 +82,54 @@ TEST_CASE("SO3 chart jets: values and derivatives agree with the chart and diffe
   CHECK(worst < 1e-9);
 }
 
+// The second derivatives (assembled from exp(xi) and dexp at 3-variable jets, so3::chart_jets):
+// the xi rows against central differences of the first derivatives at xi +- d e_l, the eta-eta
+// block against second differences of R0 exp(eta) exp(xi), and d2/dxi_dot^2 = 0.
+TEST_CASE("SO3 chart jets: second derivatives agree with differences of the first") {
+  Rotations group;
+  double R0[9];
+  so3::to_row_major(so3::exp(Vector3d(0.3, -0.7, 1.1)), R0);
+  const Vector3d xi(0.4, 0.2, -0.5), rate(1.0, -2.0, 0.5);
+  Jet2 point[9], velocity[3];
+  REQUIRE(group.chart_jets(R0, xi.data(), rate.data(), point, velocity) == nullptr);
+  const double e = 1e-5;
+  double worst = 0.0;
+  for (int l = 0; l < 3; ++l) {
+    Jet2 plus[9], minus[9], vplus[3], vminus[3];
+    const Vector3d a = xi + e * Vector3d::Unit(l), b = xi - e * Vector3d::Unit(l);
+    REQUIRE(group.chart_jets(R0, a.data(), rate.data(), plus, vplus) == nullptr);
+    REQUIRE(group.chart_jets(R0, b.data(), rate.data(), minus, vminus) == nullptr);
+    for (int k = 0; k < 9; ++k)
+      for (int j = 0; j < 6; ++j)  // d/dxi_l of dR/d(eta, xi)_j
+        worst = std::max(worst, std::abs(point[k].hessian(j, 3 + l) -
+                                         (plus[k].gradient(j) - minus[k].gradient(j)) / (2 * e)));
+    for (int k = 0; k < 3; ++k)
+      for (int j = 0; j < 6; ++j)  // d/dxi_l of dOmega/d(xi, xi_dot)_j
+        worst = std::max(worst, std::abs(velocity[k].hessian(j, l) -
+                                         (vplus[k].gradient(j) - vminus[k].gradient(j)) / (2 * e)));
+  }
+  for (int k = 0; k < 3; ++k)
+    for (int m = 0; m < 3; ++m) worst = std::max(worst, std::abs(velocity[k].hessian(3 + k, 3 + m)));
+  CAPTURE(worst);
+  CHECK(worst < 1e-8);
+  // eta-eta: (f(+k+l) - f(+k-l) - f(-k+l) + f(-k-l)) / (4 d^2).
+  const double d = 1e-4;
+  const auto curve = [&](const Vector3d& eta) {
+    return Matrix3d(so3::from_row_major(R0) * so3::exp(eta) * so3::exp(xi));
+  };
+  double worst_eta = 0.0;
+  for (int k = 0; k < 3; ++k)
+    for (int l = 0; l < 3; ++l) {
+      const Vector3d u = d * Vector3d::Unit(k), v = d * Vector3d::Unit(l);
+      const Matrix3d second = (curve(u + v) - curve(u - v) - curve(v - u) + curve(-u - v)) / (4 * d * d);
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c)
+          worst_eta = std::max(worst_eta, std::abs(point[3 * r + c].hessian(k, l) - second(r, c)));
+    }
+  CAPTURE(worst_eta);
+  CHECK(worst_eta < 1e-6);
+}
+
 TEST_CASE("lie group galerkin of degree s is of order 2s on SO3 (free body and heavy top)") {
   Rotations group;
   struct Case {
