@@ -40,15 +40,22 @@ std::unique_ptr<LieGroupGalerkinDiscreteLagrangian> make(Manifold& group, Lagran
       group, L, rule, equispaced_control_times(degree), SolverOptions{}, reduced);
 }
 
-}  // namespace
-
-TEST_CASE("SO3 chart jets: values and derivatives agree with the chart and differences of it") {
+// The chart of SO(3) at R0 = exp(0.3, -0.7, 1.1), at xi = (0.4, 0.2, -0.5) with xi_dot =
+// (1, -2, 0.5), as jets.
+struct ChartAtJets {
+  ChartAtJets() {
+    so3::to_row_major(so3::exp(Vector3d(0.3, -0.7, 1.1)), R0);
+    REQUIRE(group.chart_jets(R0, xi.data(), rate.data(), point, velocity) == nullptr);
+  }
   Rotations group;
   double R0[9];
-  so3::to_row_major(so3::exp(Vector3d(0.3, -0.7, 1.1)), R0);
-  const Vector3d xi(0.4, 0.2, -0.5), rate(1.0, -2.0, 0.5);
+  const Vector3d xi{0.4, 0.2, -0.5}, rate{1.0, -2.0, 0.5};
   Jet2 point[9], velocity[3];
-  REQUIRE(group.chart_jets(R0, xi.data(), rate.data(), point, velocity) == nullptr);
+};
+
+}  // namespace
+
+TEST_CASE_FIXTURE(ChartAtJets, "SO3 chart jets: values and derivatives agree with the chart and differences of it") {
   // Value: R0 exp(xi) and dexp_{-xi} xi_dot.
   double R[9];
   group.retract(R0, xi.data(), R);
@@ -85,13 +92,7 @@ TEST_CASE("SO3 chart jets: values and derivatives agree with the chart and diffe
 // The second derivatives (assembled from exp(xi) and dexp at 3-variable jets, so3::chart_jets):
 // the xi rows against central differences of the first derivatives at xi +- d e_l, the eta-eta
 // block against second differences of R0 exp(eta) exp(xi), and d2/dxi_dot^2 = 0.
-TEST_CASE("SO3 chart jets: second derivatives agree with differences of the first") {
-  Rotations group;
-  double R0[9];
-  so3::to_row_major(so3::exp(Vector3d(0.3, -0.7, 1.1)), R0);
-  const Vector3d xi(0.4, 0.2, -0.5), rate(1.0, -2.0, 0.5);
-  Jet2 point[9], velocity[3];
-  REQUIRE(group.chart_jets(R0, xi.data(), rate.data(), point, velocity) == nullptr);
+TEST_CASE_FIXTURE(ChartAtJets, "SO3 chart jets: second derivatives agree with differences of the first") {
   const double e = 1e-5;
   double worst = 0.0;
   for (int l = 0; l < 3; ++l) {
