@@ -13,6 +13,7 @@
 #include <cassert>
 #include <cmath>
 #include <compare>
+#include <cstring>
 
 namespace varia {
 
@@ -25,6 +26,12 @@ struct Jet2 {
 
   Jet2() = default;
   Jet2(double constant) : value(constant) {}  // NOLINT: constants convert implicitly
+  Jet2(const Jet2& other) : value(other.value) { copy_derivatives(other); }
+  Jet2& operator=(const Jet2& other) {
+    value = other.value;
+    if (this != &other) copy_derivatives(other);
+    return *this;
+  }
   // The independent variable `index` of `count`, at `x`.
   static Jet2 variable(double x, int count, int index) {
     Jet2 jet(x);
@@ -37,6 +44,22 @@ struct Jet2 {
   double value = 0.0;
   Gradient gradient;
   Hessian hessian;
+
+ private:
+  // Copies whole 64-byte blocks of the fixed-capacity storage (the gradient's 8 numbers, the
+  // Hessian's first n^2 rounded up to 8): constant-size copies the compiler inlines. Eigen copies
+  // exactly n and n^2 numbers, by a library call each, which cost more than the copies themselves
+  // for the few variables of a jet (a quarter of a shooting step's time went to them).
+  void copy_derivatives(const Jet2& other) {
+    const auto n = other.gradient.size();
+    gradient.resize(n);
+    hessian.resize(n, n);
+    if (n == 0) return;
+    constexpr std::size_t block = 8 * sizeof(double);
+    static_assert(kMaxJetVariables * sizeof(double) == block && kMaxJetVariables * kMaxJetVariables % 8 == 0);
+    std::memcpy(gradient.data(), other.gradient.data(), block);
+    for (Eigen::Index k = 0; k < n * n; k += 8) std::memcpy(hessian.data() + k, other.hessian.data() + k, block);
+  }
 };
 
 namespace jet {

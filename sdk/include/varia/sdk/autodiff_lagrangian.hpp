@@ -36,6 +36,9 @@ using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
 // allocation limit (128 kB).
 inline constexpr int kMaxJetInputs = 12;
 using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, Eigen::Dynamic, 1, 0, kMaxJetInputs, 1>>;
+// Its fixed-size counterpart for m + n = K: K jets per derivative vector, not the capacity's 12.
+template <int K>
+using FixedJetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, K, 1>>;
 
 template <class Model>
 class AutodiffLagrangian : public Lagrangian {
@@ -72,19 +75,14 @@ class AutodiffLagrangian : public Lagrangian {
 
   Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final {
     return guarded(error_, [&] {
-      const int k = m_ + n_;
-      if (k > kMaxJetInputs)
+      if (m_ + n_ > kMaxJetInputs)
         throw std::invalid_argument("evaluation at jets takes at most " +
                                     std::to_string(kMaxJetInputs) +
                                     " position and velocity numbers together");
-      Vec<JetDual> qd(m_), vd(n_);
-      for (int i = 0; i < k; ++i) {
-        JetDual z(i < m_ ? q[i] : v[i - m_], k, i);
-        (i < m_ ? qd(i) : vd(i - m_)) = z;
-      }
-      const JetDual r = model().lagrangian(qd, vd);
-      if (value != nullptr) *value = r.value();
-      for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : Jet2();
+      dispatch([&](auto first, auto, auto) {
+        constexpr int K = decltype(first)::type::DerType::SizeAtCompileTime;
+        jet_first_order<std::conditional_t<K == Eigen::Dynamic, JetDual, FixedJetDual<K>>>(q, v, value, gradient);
+      });
     });
   }
 
@@ -154,6 +152,20 @@ class AutodiffLagrangian : public Lagrangian {
     for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : 0.0;
   }
 #pragma GCC diagnostic pop
+
+  // L (if value is not null) and its gradient at jet inputs: forward mode over the jets, one
+  // derivative direction per number of (q, v); JD is JetDual or, for the common sizes,
+  // FixedJetDual<m + n> (a jet's copy is its value, gradient and Hessian: the dynamic derivative
+  // vector's capacity of 12 made every dual number 12 jets long).
+  template <class JD>
+  void jet_first_order(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) const {
+    const int k = m_ + n_;
+    Vec<JD> qd(m_), vd(n_);
+    for (int i = 0; i < k; ++i) (i < m_ ? qd(i) : vd(i - m_)) = JD(i < m_ ? q[i] : v[i - m_], k, i);
+    const JD r = model().lagrangian(qd, vd);
+    if (value != nullptr) *value = r.value();
+    for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : Jet2();
+  }
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).
   template <class D2>
