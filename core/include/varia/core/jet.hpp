@@ -78,12 +78,13 @@ inline Jet2 unary(const Jet2& a, double f, double d1, double d2) {
   double* __restrict rg = r.gradient.data();
   double* __restrict rH = r.hessian.data();
   for (int i = 0; i < n; ++i) rg[i] = d1 * g[i];
+  if (d2 == 0.0) {  // no outer product: 0 * an infinite gradient would make NaN
+    for (int k = 0; k < n * n; ++k) rH[k] = d1 * H[k];
+    return r;
+  }
   for (int j = 0; j < n; ++j) {
     const double c = d2 * g[j];
-    if (d2 == 0.0)  // no outer product: 0 * an infinite gradient would make NaN
-      for (int i = 0; i < n; ++i) rH[j * n + i] = d1 * H[j * n + i];
-    else
-      for (int i = 0; i < n; ++i) rH[j * n + i] = d1 * H[j * n + i] + c * g[i];
+    for (int i = 0; i < n; ++i) rH[j * n + i] = d1 * H[j * n + i] + c * g[i];
   }
   return r;
 }

@@ -240,10 +240,11 @@ struct MatrixJet3 {
   explicit MatrixJet3(const Matrix3<Jet2>& M) {
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) {
-        value(r, c) = M(r, c).value;
+        const Jet2& x = M(r, c);
+        value(r, c) = x.value;
         for (int l = 0; l < 3; ++l) {
-          d[l](r, c) = M(r, c).constant() ? 0.0 : M(r, c).gradient(l);
-          for (int m = 0; m < 3; ++m) dd[l][m](r, c) = M(r, c).constant() ? 0.0 : M(r, c).hessian(l, m);
+          d[l](r, c) = x.constant() ? 0.0 : x.gradient(l);
+          for (int m = 0; m < 3; ++m) dd[l][m](r, c) = x.constant() ? 0.0 : x.hessian(l, m);
         }
       }
   }
@@ -275,15 +276,17 @@ inline void chart_jets(const double* R0, const double* xi, const double* xi_dot,
   if (point != nullptr) {
     const MatrixJet3 E(exp(w));
     const Matrix3<double> B = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R0);
-    Matrix3<double> BH[3];
-    for (int k = 0; k < 3; ++k) BH[k] = B * hat(Vector3<double>(Vector3<double>::Unit(k)));
+    Matrix3<double> H[3], BH[3];  // H_k = hat(e_k), B H_k
+    for (int k = 0; k < 3; ++k) {
+      H[k] = hat(Vector3<double>(Vector3<double>::Unit(k)));
+      BH[k] = B * H[k];
+    }
     Matrix3<double> by[6], by2[6][6];  // the derivatives in the 6 variables (eta, xi)
     for (int k = 0; k < 3; ++k) {
       by[k] = BH[k] * E.value;
       by[3 + k] = B * E.d[k];
       for (int l = 0; l < 3; ++l) {
-        by2[k][l] = (BH[k] * hat(Vector3<double>(Vector3<double>::Unit(l))) +
-                     BH[l] * hat(Vector3<double>(Vector3<double>::Unit(k)))) * E.value / 2.0;
+        by2[k][l] = (BH[k] * H[l] + BH[l] * H[k]) * E.value / 2.0;
         by2[k][3 + l] = BH[k] * E.d[l];
         by2[3 + l][k] = by2[k][3 + l];
         by2[3 + k][3 + l] = B * E.dd[k][l];

@@ -91,7 +91,9 @@ class AutodiffLagrangian : public Lagrangian {
 
  private:
   const Model& model() const { return static_cast<const Model&>(*this); }
-  double at(const double* q, const double* v, int k) const { return k < m_ ? q[k] : v[k - m_]; }
+  // Number k of (q, v), q having m numbers.
+  template <class T>
+  static const T& at(const T* q, const T* v, int m, int k) { return k < m ? q[k] : v[k - m]; }
 
   // Calls f with tags (std::type_identity) of the first- and second-order scalar types for
   // k = m + n, and m as a compile-time constant (Shape): fixed-size types where k is one of the
@@ -144,7 +146,7 @@ class AutodiffLagrangian : public Lagrangian {
     Vec<D> qd(m), vd(k - m);
     for (int i = 0; i < k; ++i) {
       D& z = i < m ? qd(i) : vd(i - m);
-      z.value() = i < m ? q[i] : v[i - m];
+      z.value() = at(q, v, m, i);
       z.derivatives() = D::DerType::Unit(k, i);
     }
     const D r = model().lagrangian(qd, vd);
@@ -161,7 +163,7 @@ class AutodiffLagrangian : public Lagrangian {
   void jet_first_order(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) const {
     const int k = m_ + n_;
     Vec<JD> qd(m_), vd(n_);
-    for (int i = 0; i < k; ++i) (i < m_ ? qd(i) : vd(i - m_)) = JD(i < m_ ? q[i] : v[i - m_], k, i);
+    for (int i = 0; i < k; ++i) (i < m_ ? qd(i) : vd(i - m_)) = JD(at(q, v, m_, i), k, i);
     const JD r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value();
     for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : Jet2();
@@ -177,7 +179,7 @@ class AutodiffLagrangian : public Lagrangian {
     Vec<D2> qd(m_), vd(n_);
     for (int i = 0; i < k; ++i) {
       D2 z;
-      z.value() = D(at(q, v, i), k, i);
+      z.value() = D(at(q, v, m_, i), k, i);
       z.derivatives().resize(k);
       for (int j = 0; j < k; ++j) z.derivatives()(j) = D(i == j ? 1.0 : 0.0, Inner::Zero(k));
       (i < m_ ? qd(i) : vd(i - m_)) = z;
