@@ -14,6 +14,7 @@
 #include "assemble.hpp"
 #include "registry.hpp"
 #include "scene.hpp"
+#include "varia/core/trajectory.hpp"
 
 namespace {
 
@@ -45,10 +46,10 @@ double seconds_per_step(int particles, int steps, varia::host::Registry& registr
   const varia::host::Scene scene = varia::host::parse_scene(chain_scene(particles));
   varia::host::validate_parameters(scene, registry);
   varia::host::Assembly a = varia::host::assemble(scene, registry);
-  Eigen::VectorXd q = a.q0, p = a.p0;
-  a.map->step(q.data(), p.data(), scene.step, q.data(), p.data());
+  varia::Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, scene.step);
+  trajectory.step();
   const auto start = std::chrono::steady_clock::now();
-  for (int k = 0; k < steps; ++k) a.map->step(q.data(), p.data(), scene.step, q.data(), p.data());
+  trajectory.advance(steps);
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / steps;
 }
 

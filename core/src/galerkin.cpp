@@ -106,7 +106,7 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   impulse_.resize(n_);
   change_.resize((s_ + 1) * n_);
   q_.resize(n_);
-  v_.resize(n_);
+  v_ = Eigen::VectorXd::Zero(n_);  // the explicit form evaluates dL/dq at v = 0 (it does not depend on v there)
   velocity_ = Eigen::VectorXd::Zero(n_);
   grad_.resize(2 * n_);
   gradient_.resize((s_ + 1) * n_);
@@ -243,8 +243,9 @@ void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h
   statistics_.solves += steps;  // explicit: no Newton iterations
 }
 
-void GalerkinDiscreteLagrangian::advance(double* q, double* p, double h, long steps, double* q1, double* p1) {
-  if (explicit_advance_ == nullptr) return DiscreteHamiltonianMap::advance(q, p, h, steps, q1, p1);
+void GalerkinDiscreteLagrangian::take_steps(double* q, double* p, double t0, double h, long steps, double* q1,
+                                            double* p1) {
+  if (explicit_advance_ == nullptr) return DiscreteHamiltonianMap::take_steps(q, p, t0, h, steps, q1, p1);
   (this->*explicit_advance_)(q, p, h, steps);
 }
 
@@ -542,8 +543,8 @@ void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, 
 //   p1 - p0 = impulse_ - (dS/dq^0 + f_d^0 + p0) - sum_{0 < nu < s} (dS/dq^nu + f_d^nu),
 // the impulse less the residuals of the solved equations. Both sums are compensated across steps
 // (compensated.hpp) when a step continues from the last one's output.
-void GalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double h, double* q1,
-                                      double* p1) {
+void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, double t0, double h, double* q1,
+                                           double* p1) {
   if (explicit_advance_ != nullptr) {
     std::copy_n(q0, n_, q1);
     std::copy_n(p0, n_, p1);
@@ -554,9 +555,9 @@ void GalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double
     carry_q_.setZero();
     carry_p_.setZero();
   }
+  t_ = t0;
   warm_start(q0, p0, h);
   newton(h, 1, 0, s_, p0, !forces_.empty());
-  t_ += h;
   impulse_ -= gradient_.head(n_) + momentum;
   for (int nu = 1; nu < s_; ++nu) impulse_ -= gradient_.segment(nu * n_, n_);
   Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);

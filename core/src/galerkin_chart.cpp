@@ -237,8 +237,8 @@ void LieGroupGalerkinDiscreteLagrangian::warm_start(const double* q0, const doub
   xi_.col(0).setZero();
 }
 
-void LieGroupGalerkinDiscreteLagrangian::step(const double* q0, const double* p0, double h,
-                                              double* q1, double* p1) {
+void LieGroupGalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, double /*t0*/, double h,
+                                                   double* q1, double* p1) {
   warm_start(q0, p0, h);
   unknowns_ = s_;
   newton(q0, p0, h);

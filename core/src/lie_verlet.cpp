@@ -120,8 +120,8 @@ Eigen::Vector3d LieGroupVelocityVerlet::torque(const Eigen::Matrix3d& R) {
   return so3::trivialize(R, from_row_major(gradient_.data()));
 }
 
-void LieGroupVelocityVerlet::step(const double* q0, const double* p0, double h, double* q1,
-                                  double* p1) {
+void LieGroupVelocityVerlet::take_step(const double* q0, const double* p0, double /*t0*/, double h, double* q1,
+                                       double* p1) {
   const bool continuing = has_last_ && h == last_h_ &&
                           std::equal(q0, q0 + 9, last_state_.begin()) &&
                           std::equal(p0, p0 + 3, last_state_.begin() + 9);

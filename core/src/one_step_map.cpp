@@ -28,8 +28,8 @@ OneStepHamiltonianMap::OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lag
   method_.set_solver(options.tolerance, options.max_iterations);
 }
 
-void OneStepHamiltonianMap::step(const double* q0, const double* p0, double h, double* q1,
-                                 double* p1) {
+void OneStepHamiltonianMap::take_step(const double* q0, const double* p0, double /*t0*/, double h, double* q1,
+                                      double* p1) {
   y0_.head(m_) = Eigen::Map<const Eigen::VectorXd>(q0, m_);
   field_->inverse_mass(p0, y0_.data() + m_);
   field_->step(method_, h, y0_.data(), y1_.data(), statistics_);

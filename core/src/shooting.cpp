@@ -285,9 +285,10 @@ void ShootingDiscreteLagrangian::solve(const double* q0, double h, Target target
 
 // The paper's shooting-based implementation: w0 = v0 from the inverse Legendre transform
 // v0 = M^{-1} p0 (Lagrangian form), or w0 = p^0 guessed as p0 (Hamiltonian forms).
-void ShootingDiscreteLagrangian::step(const double* q0, const double* p0, double h, double* q1,
+void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, double t0, double h, double* q1,
                                       double* p1) {
   forced_ = !forces_.empty();
+  t_ = t0;
   if (form_ == ShootingForm::lagrangian) field_->inverse_mass(p0, w_.data());
   else w_ = Eigen::Map<const Eigen::VectorXd>(p0, n_);
   target_is_end_ = true;
@@ -300,7 +301,6 @@ void ShootingDiscreteLagrangian::step(const double* q0, const double* p0, double
     for (int r = 0; r < m_; ++r) q1[r] = state_[r].value;
     p = lambda_;  // with forces p1 = D2 L_d + f_d^+
   }
-  t_ += h;
 }
 
 const EvaluationCounters& ShootingDiscreteLagrangian::evaluations() const {

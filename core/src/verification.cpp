@@ -6,81 +6,9 @@
 #include <random>
 #include <sstream>
 
+#include "varia/core/trajectory.hpp"
+
 namespace varia {
-
-namespace {
-
-using Construction = Composition::Construction;
-
-Predictions predict_galerkin(const Composition& c) {
-  Predictions p;
-  const int order = std::min(2 * c.degree, c.quadrature_order);
-  p.ld_order = p.global_order = order;
-  if (!c.natural_chart) p.self_adjoint = c.quadrature_symmetric && c.control_times_symmetric;
-  p.symplectic = p.energy_bounded = true;
-  p.reason = "Galerkin (sec. 2): order min(2s, quadrature order); self-adjoint for a symmetric "
-             "rule and control times (on a vector space: the natural chart at q0 of a Lie group "
-             "is not symmetric); G-invariant L_d from an equivariant interpolant";
-  return p;
-}
-
-Predictions predict_shooting(const Composition& c) {
-  Predictions p;
-  p.ld_order = p.global_order = std::min(c.method_order, c.quadrature_order);
-  p.self_adjoint = c.method_self_adjoint && c.quadrature_symmetric;
-  p.symplectic = p.energy_bounded = true;
-  p.reason = "shooting (sec. 3 theorem): order min(p, q); self-adjoint for a self-adjoint method "
-             "and a symmetric rule; G-invariant for a G-equivariant method";
-  return p;
-}
-
-Predictions predict_one_step(const Composition& c) {
-  Predictions p;
-  p.global_order = c.method_order;
-  p.self_adjoint = c.method_self_adjoint;
-  p.symplectic = c.method_symplectic;
-  if (c.method_symplectic) p.energy_bounded = true;
-  p.reason = "one-step method: its declared order, self-adjointness and symplecticity (no L_d)";
-  return p;
-}
-
-Predictions predict_lie_verlet() {
-  Predictions p;
-  p.ld_order = p.global_order = 2;
-  p.self_adjoint = p.symplectic = p.energy_bounded = true;
-  p.reason = "Lie group velocity Verlet (sec. 2 example): order 2, symplectic, G-invariant";
-  return p;
-}
-
-}  // namespace
-
-Predictions predict(const Composition& c) {
-  Predictions p;
-  switch (c.construction) {
-    case Construction::galerkin: p = predict_galerkin(c); break;
-    case Construction::shooting: p = predict_shooting(c); break;
-    case Construction::one_step: p = predict_one_step(c); break;
-    case Construction::lie_verlet: p = predict_lie_verlet(); break;
-  }
-  // Discrete Noether theorem (sec. 1): a G-invariant L_d conserves the discrete momentum map.
-  if (c.lagrangian_invariant) {
-    const bool invariant = c.construction == Construction::galerkin ||
-                           c.construction == Construction::lie_verlet ||
-                           (c.construction == Construction::shooting && c.method_equivariant);
-    if (c.construction != Construction::one_step) p.g_invariant = invariant;
-    if (invariant) p.momentum_conserved = true;
-    else if (c.construction == Construction::one_step && c.method_symplectic && c.method_equivariant)
-      p.momentum_conserved = true;
-  }
-  // Forces (discrete Lagrange-d'Alembert) keep the order but none of the conservation theorems.
-  if (c.forced) {
-    p.symplectic.reset();
-    p.energy_bounded.reset();
-    p.momentum_conserved.reset();
-    p.reason += "; with forces the conservation theorems do not apply";
-  }
-  return p;
-}
 
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor) {
   OrderFit fit;
@@ -193,16 +121,11 @@ void exact_discrete_lagrangian(LagrangianEvaluator& lagrangian, const double* no
   check(plugin.exact_solution(q0, v0, h, q1, v.data()), "exact solution");
 }
 
-void run(DiscreteHamiltonianMap& map, std::vector<double> q, std::vector<double> p, double h,
+void run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::VectorXd& p, double t0, double h,
          long steps, const Observer& observe) {
-  std::vector<double> q1(q.size()), p1(p.size());
+  Trajectory trajectory(map, q, p, t0, h);
   observe(0, q.data(), p.data());
-  for (long k = 1; k <= steps; ++k) {
-    map.step(q.data(), p.data(), h, q1.data(), p1.data());
-    q.swap(q1);
-    p.swap(p1);
-    observe(k, q.data(), p.data());
-  }
+  trajectory.run_to(steps, [&](const Trajectory& x) { observe(x.steps(), x.q().data(), x.p().data()); });
 }
 
 namespace {

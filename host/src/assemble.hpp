@@ -30,10 +30,15 @@ struct Assembly {
   std::vector<std::shared_ptr<Force>> forces;  // system.forces
   std::unique_ptr<DiscreteHamiltonianMap> map;
   DiscreteLagrangian* discrete_lagrangian = nullptr;  // when the construction has one (in `map`)
-  Composition composition;  // what the parts declare, for `verify`'s predictions
-  Eigen::VectorXd q0, p0;
+  bool one_step_symplectic = false;  // what the one-step plugin declares (its "symplectic" property)
+  Eigen::VectorXd q0, p0;  // the initial state, at time t0 (initial.t)
+  double t0 = 0.0;
   Eigen::VectorXd v0;  // set when the scene gives v or observes energy or momentum
 };
+
+// Whether the whole system, Lagrangian and forces, has a closed-form solution: only then do
+// `verify` and `cost` measure against it; otherwise against a reference run of the same system.
+bool has_exact_solution(const Assembly& assembly);
 
 // Creates the plugin objects and the construction; InputError for a construction that is not
 // available, a Lagrangian that does not fit the manifold, a bad initial state or an observable the

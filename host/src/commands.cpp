@@ -155,7 +155,7 @@ int command_plugins(const CommonOptions& common, bool as_json) {
 int command_validate(const CommonOptions& common, const std::string& scene_file) {
   return with_registry(common, [&](Registry& registry) {
     const Prepared prepared = prepare(scene_file, registry);
-    fmt::print("{}: valid ({} with {} on {}, {} steps of {})\n", scene_file, prepared.scene.construction,
+    fmt::print("{}: valid ({} with {} on {}, {} steps of {})\n", scene_file, prepared.scene.construction->name(),
                prepared.scene.lagrangian.type, prepared.scene.manifold.type, prepared.scene.steps,
                prepared.scene.step);
     return 0;
@@ -176,7 +176,7 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
     Assembly& a = prepared.assembly;
     if (a.discrete_lagrangian == nullptr)
       throw InputError(fmt::format("{}: /method/construction: construction '{}' has no discrete Lagrangian",
-                                   scene_file, prepared.scene.construction));
+                                   scene_file, prepared.scene.construction->name()));
     if (!(options.h > 0.0) || !std::isfinite(options.h))
       throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
     const Eigen::VectorXd q0 = parse_numbers(options.q0, a.map->point_size(), "--q0");

@@ -19,6 +19,7 @@
 #include "plot.hpp"
 #include "registry.hpp"
 #include "scene.hpp"
+#include "varia/core/trajectory.hpp"
 #include "varia/core/verification.hpp"
 
 namespace varia::host {
@@ -92,6 +93,7 @@ Row measure(Method& m, double h, long steps) {
 
 // ---- the truth: exact solution or a converged reference run -----------------------------------
 
+// The length of the scene's run (from initial.t to t_end).
 double final_time(const Scene& scene) { return static_cast<double>(scene.steps) * scene.step; }
 
 long steps_for(double t_end, double h) { return std::max(1L, std::lround(t_end / h)); }
@@ -103,19 +105,6 @@ Truth exact_truth(Assembly& a, double t_end) {
         "exact solution");
   LagrangianEvaluator(*a.lagrangian).legendre(truth.q.data(), v.data(), truth.p.data());
   return truth;
-}
-
-// The reference construction: Galerkin of degree 4 with 4 Gauss-Legendre points, order
-// min(2s, 2 * points) = 8 (paper, sec. 2), far above the orders it checks.
-Scene galerkin_reference(const Scene& scene) {
-  Scene reference = scene;
-  reference.construction = "galerkin";
-  reference.degree = 4;
-  reference.control_times.reset();
-  reference.quadrature = PluginSpec{"/method/quadrature", "quadrature", "gauss-legendre", {{"points", 4}}};
-  reference.one_step.reset();
-  reference.form = "lagrangian";
-  return reference;
 }
 
 // Runs `a` at h, h/2, h/4, ... until two successive runs agree to `target` (at most 4 halvings):
@@ -136,8 +125,8 @@ Truth converge(const Assembly& a, double t_end, double h, double target, const s
 
 // Methods share a truth when they integrate the same system from the same state to the same time.
 std::string system_key(const Scene& s) {
-  std::string key = fmt::format("{}|{}|{}|{}|{}", s.manifold.type, s.manifold.parameters.dump(), s.lagrangian.type,
-                                s.lagrangian.parameters.dump(), final_time(s));
+  std::string key = fmt::format("{}|{}|{}|{}|{}|{}", s.manifold.type, s.manifold.parameters.dump(), s.lagrangian.type,
+                                s.lagrangian.parameters.dump(), s.t0, final_time(s));
   for (const PluginSpec& force : s.forces) key += "|" + force.type + force.parameters.dump();
   for (const auto* values : {&s.q, s.p ? &*s.p : &*s.v}) key += fmt::format("|{}", fmt::join(*values, ","));
   return key + (s.p ? "|p" : "|v");
@@ -149,7 +138,8 @@ std::string system_key(const Scene& s) {
 Truth reference_truth(const Method& m, const std::deque<Method>& methods, Registry& registry, double h_min) {
   const double t_end = final_time(m.scene), target = 1e-12 * std::max(1.0, m.assembly.q0.lpNorm<Eigen::Infinity>());
   try {
-    Assembly reference = assemble(galerkin_reference(m.scene), registry);
+    // Galerkin of degree 4 with 4 Gauss-Legendre points: order 8, far above the orders it checks.
+    Assembly reference = assemble(galerkin_reference(m.scene, 4, 4), registry);
     return converge(reference, t_end, h_min / 2, target,
                     "reference run: galerkin degree 4, gauss-legendre 4 points (order 8)");
   } catch (const std::invalid_argument&) {
@@ -181,7 +171,7 @@ void load_method(const std::string& file, Registry& registry, std::deque<Method>
     m.scene.observe = Observe{true, false, false};  // the energy error is always measured
     m.assembly = assemble(m.scene, registry);
     // The order the theorems give for the parts that assemble() recorded (verification.hpp).
-    m.predicted_order = predict(m.assembly.composition).global_order.value_or(0);
+    m.predicted_order = m.scene.construction->predict(m.scene, m.assembly).global_order.value_or(0);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", file, e.what()));
   }
@@ -304,21 +294,17 @@ void print_table(const Method& m) {
 }  // namespace
 
 TimedRun run_timed(const Assembly& a, double h, long steps, Observer* observer) {
-  TimedRun f{a.q0, a.p0, 0.0};
-  Eigen::VectorXd q1(f.q.size()), p1(f.p.size());
+  Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, h);
+  double seconds = 0.0;
   const long stride = observer ? std::max(1L, steps / kEnergySamples) : steps;
-  if (observer) observer->observe(f.q.data(), f.p.data());
-  for (long k = 0; k < steps;) {
-    const long stop = std::min(steps, k + stride);
+  if (observer) observer->observe(a.q0.data(), a.p0.data());
+  while (trajectory.steps() < steps) {
     const auto start = Clock::now();
-    a.map->advance(f.q.data(), f.p.data(), h, stop - k, q1.data(), p1.data());
-    k = stop;
-    f.seconds += std::chrono::duration<double>(Clock::now() - start).count();
-    if (!f.q.allFinite() || !f.p.allFinite())
-      throw NumericalFailure(fmt::format("a non-finite state by step {}", k), std::nan(""));
-    if (observer) observer->observe(f.q.data(), f.p.data());
+    trajectory.advance(std::min(stride, steps - trajectory.steps()));
+    seconds += std::chrono::duration<double>(Clock::now() - start).count();
+    if (observer) observer->observe(trajectory.q().data(), trajectory.p().data());
   }
-  return f;
+  return TimedRun{trajectory.q(), trajectory.p(), seconds};
 }
 
 int command_cost(const CommonOptions& common, const std::vector<std::string>& scene_files,
@@ -335,7 +321,7 @@ int command_cost(const CommonOptions& common, const std::vector<std::string>& sc
     auto [it, fresh] = truths.try_emplace(system_key(m.scene));
     if (fresh) {
       progress(options, fmt::format("varia: cost: the truth for {}", m.name));
-      it->second = m.assembly.lagrangian->has_exact_solution() ? exact_truth(m.assembly, final_time(m.scene))
+      it->second = has_exact_solution(m.assembly) ? exact_truth(m.assembly, final_time(m.scene))
                                                                  : reference_truth(m, methods, registry, h_min);
     }
     m.truth = &it->second;

@@ -13,6 +13,7 @@
 #include "output.hpp"
 #include "plot.hpp"
 #include "registry.hpp"
+#include "varia/core/trajectory.hpp"
 
 namespace varia::host {
 
@@ -53,11 +54,8 @@ std::vector<std::string> csv_columns(int point_size, int dim, const Observer& ob
   return columns;
 }
 
-// The state of a run as it goes, and what the run record reports.
-struct Trajectory {
-  Eigen::VectorXd q, p, q1, p1;
-  long step = 0;  // steps completed
-  double t = 0.0;
+// What the run record reports besides the trajectory's state.
+struct Outcome {
   double wall_seconds = 0.0;
 };
 
@@ -68,23 +66,22 @@ struct Failure {
   std::string message;
 };
 
-bool finite(const Eigen::VectorXd& x) { return x.allFinite(); }
 
 // Spec "Outputs": the run record's keys.
 json run_record(const Scene& scene, const Assembly& a, const Observer& observer, const Trajectory& state,
-                const Registry& registry) {
+                const Outcome& outcome, const Registry& registry) {
   const auto& statistics = a.map->solver_statistics();
   const auto& evaluations = a.map->evaluations();
   json record{
-      {"steps", state.step},
-      {"wall_seconds", state.wall_seconds},
+      {"steps", state.steps()},
+      {"wall_seconds", outcome.wall_seconds},
       {"newton_iterations", {{"mean", statistics.mean()}, {"max", statistics.max_iterations}}},
       {"evaluations",
        {{"lagrangian", evaluations.lagrangian},
         {"gradient", evaluations.gradient},
         {"hessian", evaluations.hessian},
         {"force", evaluations.force}}},
-      {"final", {{"t", state.t}, {"q", as_vector(state.q)}, {"p", as_vector(state.p)}}},
+      {"final", {{"t", state.t()}, {"q", as_vector(state.q())}, {"p", as_vector(state.p())}}},
   };
   if (scene.observe.energy) record["energy_error_max"] = observer.energy_error();
   if (scene.observe.momentum) record["momentum_error_max"] = observer.momentum_error();
@@ -94,21 +91,18 @@ json run_record(const Scene& scene, const Assembly& a, const Observer& observer,
 }
 
 void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, const Observer& observer,
-                         const Trajectory& state) {
+                         const Trajectory& state, const Outcome& outcome) {
   const auto& statistics = a.map->solver_statistics();
-  std::string method = scene.construction;
-  if (scene.construction == "galerkin") method += fmt::format(" degree {}", scene.degree);
-  if (scene.one_step) method += " with " + scene.one_step->type;
-  if (scene.quadrature) method += ", quadrature " + scene.quadrature->type + " " + scene.quadrature->parameters.dump();
+  const std::string method = scene.construction->describe(scene);
   fmt::print(to, "system            {} on {}\n", scene.lagrangian.type, scene.manifold.type);
   fmt::print(to, "method            {}, h = {}\n", method, scene.step);
-  fmt::print(to, "steps             {}\n", state.step);
-  fmt::print(to, "final time        {:.10g}\n", state.t);
+  fmt::print(to, "steps             {}\n", state.steps());
+  fmt::print(to, "final time        {:.10g}\n", state.t());
   if (scene.observe.energy) fmt::print(to, "energy error max  {:.3e}\n", observer.energy_error());
   if (scene.observe.momentum) fmt::print(to, "momentum error    {:.3e}\n", observer.momentum_error());
   if (scene.observe.orthogonality) fmt::print(to, "orthogonality     {:.3e}\n", observer.orthogonality_error());
   fmt::print(to, "Newton iterations mean {:.2f}, max {}\n", statistics.mean(), statistics.max_iterations);
-  fmt::print(to, "wall time         {:.4f} s\n", state.wall_seconds);
+  fmt::print(to, "wall time         {:.4f} s\n", outcome.wall_seconds);
 }
 
 // The written rows, kept for `run --plot`: q(t) (up to three coordinates) beside the energy error
@@ -140,14 +134,14 @@ class PlotRecorder {
   std::vector<Series> coordinates_, right_;
 };
 
+// The run: the scene's trajectory (core/trajectory.hpp) observed and written at every step.
 class Stepper {
  public:
   Stepper(const Scene& scene, Assembly& a, const RunOptions& options)
-      : scene_(scene), a_(a), observer_(scene.observe, *a.manifold, *a.lagrangian, a.v0, scene.solver) {
-    state_.q = a.q0;
-    state_.p = a.p0;
-    state_.q1.resize(a.q0.size());
-    state_.p1.resize(a.p0.size());
+      : scene_(scene),
+        a_(a),
+        observer_(scene.observe, *a.manifold, *a.lagrangian, a.v0, scene.solver),
+        trajectory_(*a.map, a.q0, a.p0, a.t0, scene.step) {
     if (options.out) csv_ = std::make_unique<CsvWriter>(*options.out);
     if (options.plot) plot_ = std::make_unique<PlotRecorder>(scene.observe.energy);
   }
@@ -161,23 +155,22 @@ class Stepper {
     std::optional<Failure> failure;
     try {
       start_output();
-      while (state_.step < scene_.steps) {
-        advance();
-        progress.update(state_.step);
-      }
-    } catch (const NumericalFailure& e) {
-      // A non-finite observable is found after its step completed: that step failed, from the
-      // time it started at.
-      failure = observable_failed_
-                    ? Failure{state_.step, std::max(0L, state_.step - 1) * scene_.step, e.residual(), e.what()}
-                    : Failure{state_.step + 1, state_.t, e.residual(), e.what()};
+      trajectory_.run_to(scene_.steps, [&](const Trajectory& x) {
+        observe_and_write();
+        progress.update(x.steps());
+      });
+    } catch (const StepFailure& e) {
+      failure = Failure{e.step(), e.t(), e.residual(), e.what()};
+    } catch (const NumericalFailure& e) {  // an observable that could not be formed
+      failure = observable_failure(e.what(), e.residual());
     }
-    state_.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
+    outcome_.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (csv_) csv_->flush();
     return failure;
   }
 
-  const Trajectory& state() const { return state_; }
+  const Trajectory& state() const { return trajectory_; }
+  const Outcome& outcome() const { return outcome_; }
   const Observer& observer() const { return observer_; }
 
  private:
@@ -186,43 +179,38 @@ class Stepper {
     observe_and_write();
   }
 
-  void advance() {
-    a_.map->set_time(state_.t);
-    a_.map->step(state_.q.data(), state_.p.data(), scene_.step, state_.q1.data(), state_.p1.data());
-    if (!finite(state_.q1) || !finite(state_.p1)) throw NumericalFailure("a non-finite state", std::nan(""));
-    state_.q.swap(state_.q1);
-    state_.p.swap(state_.p1);
-    ++state_.step;
-    state_.t = state_.step * scene_.step;
-    observe_and_write();
+  // An observable found wrong after its step completed: that step failed, from the time it started at.
+  Failure observable_failure(const std::string& message, double residual) const {
+    const long k = trajectory_.steps();
+    return Failure{k, scene_.t0 + static_cast<double>(std::max(k - 1, 0L)) * scene_.step, residual, message};
   }
 
   // Spec "output.every": every k-th step; step 0 and the last step are always written.
   void observe_and_write() {
-    observer_.observe(state_.q.data(), state_.p.data());
+    const long k = trajectory_.steps();
+    const Eigen::VectorXd& q = trajectory_.q();
+    const Eigen::VectorXd& p = trajectory_.p();
+    observer_.observe(q.data(), p.data());
     // Never a non-finite number in the trajectory: an observable that overflows (energy of a
     // finite but huge state) ends the run like a non-finite state does.
     const auto& values = observer_.values();
     for (std::size_t i = 0; i < values.size(); ++i)
-      if (!std::isfinite(values[i])) {
-        observable_failed_ = true;
-        throw NumericalFailure(fmt::format("a non-finite {} ({})", observer_.columns()[i], values[i]),
-                               std::nan(""));
-      }
-    const bool due = state_.step % scene_.output_every == 0 || state_.step == scene_.steps;
+      if (!std::isfinite(values[i]))
+        throw NumericalFailure(fmt::format("a non-finite {} ({})", observer_.columns()[i], values[i]), std::nan(""));
+    const bool due = k % scene_.output_every == 0 || k == scene_.steps;
     if (csv_ && due)
-      csv_->row(state_.t, state_.q.data(), static_cast<int>(state_.q.size()), state_.p.data(),
-                static_cast<int>(state_.p.size()), observer_.values());
-    if (plot_ && due) plot_->record(state_.t, state_.q, state_.p, observer_.values());
+      csv_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()),
+                values);
+    if (plot_ && due) plot_->record(trajectory_.t(), q, p, values);
   }
 
   const Scene& scene_;
   Assembly& a_;
   Observer observer_;
-  Trajectory state_;
+  Trajectory trajectory_;
+  Outcome outcome_;
   std::unique_ptr<CsvWriter> csv_;
   std::unique_ptr<PlotRecorder> plot_;
-  bool observable_failed_ = false;
 };
 
 // The failure's residual in the run record: its number, or where it is not finite (a non-finite
@@ -238,7 +226,7 @@ json residual_json(double residual) {
 void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options) {
   Stepper stepper(scene, assembly, options);
   const auto failure = stepper.run(options.quiet);
-  json record = run_record(scene, assembly, stepper.observer(), stepper.state(), registry);
+  json record = run_record(scene, assembly, stepper.observer(), stepper.state(), stepper.outcome(), registry);
   if (failure)
     record["failure"] = {{"step", failure->step},
                          {"t", failure->t},
@@ -252,7 +240,7 @@ void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry,
                            failure->residual);
   // With the trajectory on stdout, the human summary goes to stderr.
   if (!options.quiet) print_human_summary(options.out && *options.out == "-" ? stderr : stdout, scene, assembly,
-                                          stepper.observer(), stepper.state());
+                                          stepper.observer(), stepper.state(), stepper.outcome());
 }
 
 }  // namespace varia::host

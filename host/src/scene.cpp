@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <map>
 
 #include "json_reader.hpp"
 #include "json_schema.hpp"
@@ -32,47 +33,37 @@ std::optional<PluginSpec> optional_plugin(const json& method, const char* key, c
 }
 
 // Spec: "step is h; exactly one of t_end or steps". t_end must be a whole number of steps.
-long steps_of(const json& document, double step) {
+long steps_of(const json& document, double t0, double step) {
   if (document.contains("steps")) return document["steps"].get<long>();
   const double t_end = document["t_end"].get<double>();
-  const double ratio = t_end / step;
+  if (!(t_end > t0))
+    throw InputError(fmt::format("/t_end: expected a final time after the start time /initial/t = {}; found {}", t0,
+                                 t_end));
+  const double ratio = (t_end - t0) / step;
   constexpr double kMaxSteps = 1e12;
   if (ratio > kMaxSteps)
     throw InputError(fmt::format("/t_end: expected at most {:g} steps; t_end / step is {:g}", kMaxSteps, ratio));
   const long steps = std::lround(ratio);
-  if (steps < 1 || std::abs(steps * step - t_end) > 1e-9 * std::max(1.0, t_end))
+  if (steps < 1 || std::abs(steps * step - (t_end - t0)) > 1e-9 * std::max(1.0, std::abs(t_end)))
     throw InputError(fmt::format(
         "/t_end: expected a whole number of steps of {} (t_end / step = {:.17g}); found {}", step, ratio, t_end));
   return steps;
 }
 
-// Spec: s+1 control points at times 0 = d_0 < ... < d_s = 1.
-void check_control_times(const std::vector<double>& times, int degree) {
-  bool ok = static_cast<int>(times.size()) == degree + 1 && times.front() == 0.0 && times.back() == 1.0;
-  for (std::size_t i = 1; ok && i < times.size(); ++i) ok = times[i - 1] < times[i];
-  if (!ok)
-    throw InputError(fmt::format(
-        "/method/control_times: expected degree + 1 = {} increasing numbers from 0 to 1; found {}", degree + 1,
-        brief(json(times))));
-}
-
+// The construction checks and reads its own keys; the generic parts (quadrature, one-step method,
+// solver options) are read here.
 void read_method(const json& method, Scene& scene) {
-  scene.construction = method["construction"].get<std::string>();
+  scene.construction = &construction_named(method["construction"].get<std::string>());
+  static std::map<const Construction*, SchemaValidator> validators;
+  auto validator = validators.find(scene.construction);
+  if (validator == validators.end())
+    validator = validators.emplace(scene.construction, SchemaValidator(scene.construction->schema())).first;
+  validator->second.validate(method, "/method");
+  scene.method_options = scene.construction->read(method);
   scene.quadrature = optional_plugin(method, "quadrature", "quadrature");
   scene.one_step = optional_plugin(method, "one_step", "one_step");
-  scene.degree = method.value("degree", 0);
-  scene.form = method.value("form", scene.form);
-  scene.reduced = method.value("reduced", false);
-  if (method.contains("control_times")) {
-    scene.control_times = method["control_times"].get<std::vector<double>>();
-    check_control_times(*scene.control_times, scene.degree);
-  }
-  if (!method.contains("solver")) return;
+  if (!method.contains("solver") || !method["solver"].is_object()) return;
   const json& solver = method["solver"];
-  if (solver.is_string()) {
-    scene.group_solver = solver.get<std::string>();
-    return;
-  }
   scene.solver.tolerance = solver.value("tolerance", scene.solver.tolerance);
   scene.solver.max_iterations = solver.value("max_iterations", scene.solver.max_iterations);
 }
@@ -120,10 +111,11 @@ Scene parse_scene(const json& document) {
     scene.forces.push_back(plugin_spec(forces[i], fmt::format("/system/forces/{}", i), "force"));
   read_method(document["method"], scene);
   scene.step = document["step"].get<double>();
-  scene.steps = steps_of(document, scene.step);
+  const json& initial = document["initial"];
+  scene.t0 = initial.value("t", 0.0);
+  scene.steps = steps_of(document, scene.t0, scene.step);
   read_observe(document, scene);
   if (document.contains("output")) scene.output_every = document["output"].value("every", 1);
-  const json& initial = document["initial"];
   scene.q = initial["q"].get<std::vector<double>>();
   if (initial.contains("p")) scene.p = initial["p"].get<std::vector<double>>();
   if (initial.contains("v")) scene.v = initial["v"].get<std::vector<double>>();

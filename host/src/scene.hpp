@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "constructions/construction.hpp"
 #include "json_reader.hpp"  // read_json_file
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/core/manifold.hpp"
@@ -29,19 +30,16 @@ struct Observe {
 };
 
 struct Scene {
-  std::string construction;  // galerkin | shooting | one-step | lie-verlet
+  const Construction* construction = nullptr;  // method.construction, from the table
+  std::shared_ptr<const MethodOptions> method_options;  // its own keys of "method", read by it
   PluginSpec manifold, lagrangian;
   std::vector<PluginSpec> effects;  // the lagrangian's "terms" (a composite's effects)
   std::vector<PluginSpec> forces;
-  std::optional<PluginSpec> quadrature, one_step;
-  int degree = 0;                                    // galerkin
-  std::optional<std::vector<double>> control_times;  // galerkin, checked against degree
-  bool reduced = false;                              // galerkin on a Lie group
-  std::string form = "lagrangian";                   // shooting
-  std::string group_solver = "cayley";               // lie-verlet
+  std::optional<PluginSpec> quadrature, one_step;  // the parts a construction names in "method"
   SolverOptions solver;
+  double t0 = 0.0;  // initial.t: the start time
   double step = 0.0;
-  long steps = 0;  // given, or round(t_end / step)
+  long steps = 0;  // given, or round((t_end - t0) / step)
   Observe observe;
   int output_every = 1;
   std::vector<double> q;

@@ -8,9 +8,8 @@
 #include <cmath>
 #include <numeric>
 
+#include "constructions/construction.hpp"
 #include "registry.hpp"
-#include "varia/core/galerkin.hpp"
-#include "varia/core/galerkin_chart.hpp"
 
 namespace varia::host {
 
@@ -76,15 +75,11 @@ std::shared_ptr<Quadrature> gauss_legendre(Context& x, int points) {
                                           sdk::Context{x.scene.manifold.type, x.m, x.n});
 }
 
-// A Galerkin construction of the scene's system of the given degree, as a reference: on a Lie
-// group in the natural chart (core/galerkin_chart.hpp). It is both a discrete Lagrangian and its
-// discrete Hamiltonian map.
-std::unique_ptr<DiscreteHamiltonianMap> reference_galerkin(Context& x, Quadrature& rule, int degree) {
-  if (x.a.manifold->is_vector_space())
-    return std::make_unique<GalerkinDiscreteLagrangian>(*x.a.manifold, *x.a.lagrangian, rule,
-                                                        equispaced_control_times(degree), x.scene.solver);
-  return std::make_unique<LieGroupGalerkinDiscreteLagrangian>(*x.a.manifold, *x.a.lagrangian, rule,
-                                                              equispaced_control_times(degree), x.scene.solver);
+// A Galerkin construction of the scene's system (forces included) of the given degree with
+// `points` Gauss-Legendre points, as a reference (constructions/galerkin.cpp): on a Lie group in the
+// natural chart. It is both a discrete Lagrangian and its discrete Hamiltonian map.
+Assembly reference_galerkin(Context& x, int degree, int points) {
+  return assemble(galerkin_reference(x.scene, degree, points), x.registry);
 }
 
 // ---- self_adjoint --------------------------------------------------------------------------------
@@ -93,8 +88,8 @@ std::unique_ptr<DiscreteHamiltonianMap> reference_galerkin(Context& x, Quadratur
 double map_symmetry_residual(Context& x) {
   const double h = x.scene.step;
   std::vector<double> q1(x.m), p1(x.n), q2(x.m), p2(x.n);
-  x.a.map->step(x.a.q0.data(), x.a.p0.data(), h, q1.data(), p1.data());
-  x.a.map->step(q1.data(), p1.data(), -h, q2.data(), p2.data());
+  x.a.map->step(x.a.q0.data(), x.a.p0.data(), x.a.t0, h, q1.data(), p1.data());
+  x.a.map->step(q1.data(), p1.data(), x.a.t0 + h, -h, q2.data(), p2.data());
   double worst = 0.0;
   for (int i = 0; i < x.m; ++i) worst = std::max(worst, std::abs(q2[i] - x.a.q0[i]));
   for (int i = 0; i < x.n; ++i) worst = std::max(worst, std::abs(p2[i] - x.a.p0[i]));
@@ -117,7 +112,7 @@ PropertyCheck self_adjoint(Context& x) {
 
 PropertyCheck g_invariant(Context& x) {
   const json predicted = prediction(x.predictions.g_invariant);
-  if (!x.a.composition.lagrangian_invariant)
+  if (std::string(x.a.lagrangian->symmetry_group()) == "none")
     return not_measured("g_invariant", predicted, "the Lagrangian declares no symmetry group");
   if (x.a.discrete_lagrangian == nullptr)
     return not_measured("g_invariant", predicted, "this construction has no discrete Lagrangian");
@@ -136,8 +131,7 @@ PropertyCheck momentum_conserved(Context& x) {
   if (k <= 0) return not_measured("momentum_conserved", predicted, "the Lagrangian declares no momentum map");
   std::vector<double> J(k), J0(k), v(x.n, 0.0);
   double worst = 0.0, scale = 1.0;
-  run(*x.a.map, std::vector<double>(x.a.q0.data(), x.a.q0.data() + x.m),
-      std::vector<double>(x.a.p0.data(), x.a.p0.data() + x.n), x.scene.step, kMomentumRun,
+  run(*x.a.map, x.a.q0, x.a.p0, x.a.t0, x.scene.step, kMomentumRun,
       [&](long step, const double* q, const double* p) {
         v = velocity_of(x, q, p, v);
         check(x.a.lagrangian->momentum(q, v.data(), J.data()), "momentum map");
@@ -168,8 +162,7 @@ std::vector<double> generic_velocity(std::vector<double> v) {
   return v;
 }
 
-ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine,
-                 std::unique_ptr<DiscreteHamiltonianMap>& reference) {
+ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& reference) {
   const auto v0 = initial_velocity(x);
   std::vector<double> qa(x.m), va(x.n);
   if (x.a.lagrangian->has_exact_solution()) {
@@ -183,15 +176,13 @@ ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine,
             },
             qa, "the exact discrete Lagrangian (exact solution from its state at t = 0.37, 16-point Gauss-Legendre)"};
   }
-  fine = gauss_legendre(x, 8);
-  reference = reference_galerkin(x, *fine, 6);
+  reference = reference_galerkin(x, 6, 8);
   const auto v = generic_velocity(v0);
   return {[&x, &reference, v](double h, std::vector<double>& q1, double& LdE) {
             std::vector<double> xi(v);
             for (double& c : xi) c *= h;
             check(x.a.manifold->retract(x.a.q0.data(), xi.data(), q1.data()), "retract");
-            dynamic_cast<DiscreteLagrangian&>(*reference).evaluate(x.a.q0.data(), q1.data(), h, &LdE, nullptr,
-                                                                    nullptr);
+            reference.discrete_lagrangian->evaluate(x.a.q0.data(), q1.data(), h, &LdE, nullptr, nullptr);
           },
           std::vector<double>(x.a.q0.data(), x.a.q0.data() + x.m),
           "a reference Galerkin L_d of order 12 (degree 6, 8 Gauss-Legendre points)"};
@@ -222,7 +213,7 @@ PropertyCheck ld_order(Context& x) {
   if (x.a.discrete_lagrangian == nullptr)
     return not_measured("ld_order", nullptr, "this construction has no discrete Lagrangian");
   std::shared_ptr<Quadrature> fine;
-  std::unique_ptr<DiscreteHamiltonianMap> reference;
+  Assembly reference;
   const ExactLd exact = exact_ld(x, fine, reference);
   std::vector<double> hs, errors, q1(x.m);
   double scale = 0.0;
@@ -252,29 +243,28 @@ double state_distance(Context& x, const double* q, const double* p, const double
 
 void final_state(DiscreteHamiltonianMap& map, Context& x, double h, long steps, std::vector<double>& q,
                  std::vector<double>& p) {
-  run(map, std::vector<double>(x.a.q0.data(), x.a.q0.data() + x.m),
-      std::vector<double>(x.a.p0.data(), x.a.p0.data() + x.n), h, steps,
+  run(map, x.a.q0, x.a.p0, x.a.t0, h, steps,
       [&](long k, const double* qk, const double* pk) {
         if (k == steps) q.assign(qk, qk + x.m), p.assign(pk, pk + x.n);
       });
 }
 
-// The state at time T: exact where the Lagrangian has an exact solution, else a run of a
-// Galerkin construction of order 8 (degree 4, 4 Gauss-Legendre points; in the natural chart on a
-// Lie group) with step h.
+// The state at time T after the start: exact where the whole system (Lagrangian and forces) has a
+// closed-form solution, else a run of a Galerkin construction of order 8 of the same system
+// (degree 4, 4 Gauss-Legendre points, the scene's forces; in the natural chart on a Lie group)
+// with step h.
 std::string reference_state(Context& x, double T, double h, std::vector<double>& q, std::vector<double>& p) {
   q.resize(x.m);
   p.resize(x.n);
-  if (x.a.lagrangian->has_exact_solution()) {
+  if (has_exact_solution(x.a)) {
     auto v0 = initial_velocity(x);
     std::vector<double> v(x.n);
     check(x.a.lagrangian->exact_solution(x.a.q0.data(), v0.data(), T, q.data(), v.data()), "exact solution");
     x.lagrangian.legendre(q.data(), v.data(), p.data());
     return "the exact solution";
   }
-  auto quadrature = gauss_legendre(x, 4);
-  const auto reference = reference_galerkin(x, *quadrature, 4);
-  final_state(*reference, x, h, std::lround(T / h), q, p);
+  Assembly reference = reference_galerkin(x, 4, 4);
+  final_state(*reference.map, x, h, std::lround(T / h), q, p);
   return fmt::format("a reference run (Galerkin degree 4, 4 Gauss-Legendre points, h = {:.3g})", h);
 }
 
@@ -310,8 +300,7 @@ PropertyCheck energy_bounded(Context& x) {
   const json predicted = prediction(x.predictions.energy_bounded);
   std::vector<double> errors, v(x.n, 0.0);
   double E0 = 0.0;
-  run(*x.a.map, std::vector<double>(x.a.q0.data(), x.a.q0.data() + x.m),
-      std::vector<double>(x.a.p0.data(), x.a.p0.data() + x.n), x.scene.step, kLongRun,
+  run(*x.a.map, x.a.q0, x.a.p0, x.a.t0, x.scene.step, kLongRun,
       [&](long k, const double* q, const double* p) {
         v = velocity_of(x, q, p, v);
         const double E = x.lagrangian.energy(q, v.data());
@@ -339,7 +328,7 @@ bool PropertyCheck::failed() const {
 }
 
 std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& a, Registry& registry) {
-  Context x{scene, a, registry, LagrangianEvaluator(*a.lagrangian), predict(a.composition),
+  Context x{scene, a, registry, LagrangianEvaluator(*a.lagrangian), scene.construction->predict(scene, a),
             a.manifold->dim(), a.manifold->point_size()};
   return {self_adjoint(x), g_invariant(x), ld_order(x), global_order(x),
           momentum_conserved(x), symplectic(x), energy_bounded(x)};

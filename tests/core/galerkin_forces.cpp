@@ -24,7 +24,7 @@ double final_error(int degree, FixedRule rule, double h, double amplitude) {
                                  {&force});
   const double T = 10.0;
   double q = 1.0, p = 0.0;
-  for (long k = 0; k < std::lround(T / h); ++k) map.step(&q, &p, h, &q, &p);
+  for (long k = 0; k < std::lround(T / h); ++k) map.step(&q, &p, static_cast<double>(k) * h, h, &q, &p);
   return std::abs(q - damped_exact(T, 1.0, amplitude));
 }
 

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/fixtures.hpp"
+#include "varia/core/trajectory.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/sdk/runge_kutta.hpp"
 
@@ -60,16 +61,12 @@ struct EulerMaclaurin2 : FixedRule {
 };
 
 // (q, p) after `steps` steps of size h from (q0, p0).
-inline Eigen::VectorXd run(DiscreteHamiltonianMap& map, Eigen::VectorXd q, Eigen::VectorXd p,
+inline Eigen::VectorXd run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::VectorXd& p,
                            double h, int steps) {
-  Eigen::VectorXd q1(q.size()), p1(p.size());
-  for (int k = 0; k < steps; ++k) {
-    map.step(q.data(), p.data(), h, q1.data(), p1.data());
-    q = q1;
-    p = p1;
-  }
+  Trajectory trajectory(map, q, p, 0.0, h);
+  trajectory.advance(steps);
   Eigen::VectorXd state(2 * q.size());
-  state << q, p;
+  state << trajectory.q(), trajectory.p();
   return state;
 }
 

@@ -67,7 +67,7 @@ const std::map<std::string, std::string> kBadScenes{
     {"p-and-v.json", "/initial/p: not allowed here"},
     {"reduced-heavy-top.json", "/method/reduced: the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group"},
     {"reduced-on-rn.json", "/method/reduced: the reduced (Euler-Poincare) form is for Lie groups"},
-    {"reduced-with-shooting.json", "/method/reduced: not allowed here"},
+    {"reduced-with-shooting.json", "/method/reduced: unknown key 'reduced'; the keys allowed here are: construction, form"},
     {"so3-not-orthogonal.json", "/initial/q: expected a point of SO3: R is not orthogonal"},
     {"so3-q-size.json", "/initial/q: expected 9 numbers"},
     {"so3-reflection.json", "/initial/q: expected a point of SO3: R is a reflection, not a rotation"},

@@ -84,5 +84,35 @@ TEST_CASE("cost names a method by the scene's \"name\" and runs the step sizes g
   CHECK(sweeps.at("Stormer-Verlet").h == std::vector<double>{0.02, 0.01, 0.005});
 }
 
+TEST_CASE("cost on forced scenes (damping, periodic force, both; galerkin and shooting) fits the predicted order 4 "
+          "against a reference run of the forced system") {
+  TempDir dir;
+  const nlohmann::json base = nlohmann::json::parse(read_file(kSourceDir / "scenes/effects/damped-driven-oscillator.json"));
+  const nlohmann::json forces = base["system"]["forces"];
+  std::string files;
+  for (const auto& [name, chosen] : std::map<std::string, nlohmann::json>{
+           {"damping", nlohmann::json::array({forces[0]})}, {"periodic", nlohmann::json::array({forces[1]})}, {"both", forces}}) {
+    nlohmann::json scene = base;
+    scene["system"]["forces"] = chosen;
+    scene["t_end"] = 10.0;
+    scene["name"] = name;
+    write_file(dir / (name + ".json"), scene.dump());
+    files += " '" + (dir / (name + ".json")).string() + "'";
+  }
+  const auto outcome = run_varia("cost" + files + " scenes/effects/damped-driven-shooting.json --quiet --out '" +
+                                 (dir / "out").string() + "'");
+  CAPTURE(outcome.err);
+  REQUIRE(outcome.code == 0);
+  const auto record = nlohmann::json::parse(read_file(dir / "out" / "cost.json"));
+  REQUIRE(record["methods"].size() == 4);
+  for (const auto& m : record["methods"]) {
+    CAPTURE(m.dump());
+    CHECK(m["predicted_order"] == 4);
+    CHECK(m["points_fitted"].get<int>() >= 4);
+    CHECK(m["fitted_slope"].get<double>() == doctest::Approx(4.0).epsilon(0.3 / 4));
+    CHECK(m["reference"].get<std::string>().rfind("reference run", 0) == 0);
+  }
+}
+
 }  // namespace
 }  // namespace varia::test

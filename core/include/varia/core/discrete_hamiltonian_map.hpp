@@ -51,30 +51,47 @@ class NumericalFailure : public std::runtime_error {
   double residual_;
 };
 
+// The time travels with the state: every step is taken from a state (q0, p0) at a time t0 that the
+// caller passes (core/trajectory.hpp carries (q, p, t) through a run); a map keeps no clock. Only
+// forced systems read t0 (time-dependent forces, force.hpp); the five-argument forms are the
+// autonomous shorthand, a step from t0 = 0.
 class DiscreteHamiltonianMap {
  public:
   virtual ~DiscreteHamiltonianMap() = default;
   virtual int point_size() const = 0;  // numbers per configuration point
   virtual int dim() const = 0;         // numbers per momentum
-  // One step of size h from (q0, p0) to (q1, p1). Throws NumericalFailure.
-  virtual void step(const double* q0, const double* p0, double h, double* q1, double* p1) = 0;
-  // `steps` steps of size h from (q, p), in place, with nothing observed in between (the loop
-  // `varia cost` and the benchmarks time); q1, p1 are workspace of q's and p's sizes. A map may
-  // override it to keep its state in registers across steps (the explicit Galerkin form does).
+  // One step of size h from (q0, p0) at time t0 to (q1, p1). Throws NumericalFailure.
+  void step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) {
+    take_step(q0, p0, t0, h, q1, p1);
+  }
+  void step(const double* q0, const double* p0, double h, double* q1, double* p1) {
+    take_step(q0, p0, 0.0, h, q1, p1);
+  }
+  // `steps` steps of size h from (q, p) at time t0, in place, with nothing observed in between
+  // (the loop `varia cost` and the benchmarks time); q1, p1 are workspace of q's and p's sizes.
   // Throws NumericalFailure, and (q, p) are then unspecified: a caller that needs the last good
-  // state steps with step().
-  virtual void advance(double* q, double* p, double h, long steps, double* q1, double* p1) {
+  // state steps with step() (core/trajectory.hpp does).
+  void advance(double* q, double* p, double t0, double h, long steps, double* q1, double* p1) {
+    take_steps(q, p, t0, h, steps, q1, p1);
+  }
+  void advance(double* q, double* p, double h, long steps, double* q1, double* p1) {
+    take_steps(q, p, 0.0, h, steps, q1, p1);
+  }
+  virtual const SolverStatistics& solver_statistics() const = 0;
+  virtual const EvaluationCounters& evaluations() const = 0;
+
+ protected:
+  virtual void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) = 0;
+  // The default takes one step after another, step k from t0 + k h (a product, not a sum: no
+  // round-off accumulates in the time). A map may override it to keep its state in registers
+  // across steps (the explicit Galerkin form does).
+  virtual void take_steps(double* q, double* p, double t0, double h, long steps, double* q1, double* p1) {
     for (long k = 0; k < steps; ++k) {
-      step(q, p, h, q1, p1);
+      take_step(q, p, t0 + static_cast<double>(k) * h, h, q1, p1);
       std::copy_n(q1, point_size(), q);
       std::copy_n(p1, dim(), p);
     }
   }
-  // The time at the start of the next step, for time-dependent forces (force.hpp); a map with
-  // forces advances it by h on each step. Maps without forces ignore it.
-  virtual void set_time(double /*t*/) {}
-  virtual const SolverStatistics& solver_statistics() const = 0;
-  virtual const EvaluationCounters& evaluations() const = 0;
 };
 
 // A discrete Lagrangian L_d(q0, q1; h) (paper, sec. 1) with its derivatives D1 L_d, D2 L_d (on a

@@ -57,13 +57,14 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
                 double* D2) override;
   int point_size() const override { return n_; }
   int dim() const override { return n_; }
-  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
-  void advance(double* q, double* p, double h, long steps, double* q1, double* p1) override;
-  void set_time(double t) override { t_ = t; }
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override;
   // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).
   const std::vector<double>& last_residuals() const { return residuals_; }
+
+ protected:
+  void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
+  void take_steps(double* q, double* p, double t0, double h, long steps, double* q1, double* p1) override;
 
  private:
   enum class Order { value, gradient, hessian };
@@ -116,7 +117,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
 
   LagrangianEvaluator lagrangian_;
   Forces forces_;
-  double t_ = 0.0;  // the time at the start of the next step
+  double t_ = 0.0;  // the time at the start of the step being taken
   mutable EvaluationCounters counters_;
   LagrangeBasis basis_;
   Eigen::VectorXd weights_, nodes_;

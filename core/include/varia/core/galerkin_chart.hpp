@@ -51,7 +51,10 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
                 double* D2) override;
   int point_size() const override { return m_; }
   int dim() const override { return n_; }
-  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
+ protected:
+  void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
+
+ public:
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
   // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).

@@ -40,7 +40,10 @@ class LieGroupVelocityVerlet : public DiscreteLagrangian, public DiscreteHamilto
   int dim() const override { return 3; }
   // Throws NumericalFailure when F J_d - J_d F^T = hat(g) has no solution on the branch through
   // F = I: the step turns the body too far (about h |Omega| > 1 for a spin about a principal axis).
-  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
+ protected:
+  void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
+
+ public:
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
   // Residual norms of the last Newton solve, one per iteration.

@@ -26,7 +26,10 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
                         SolverOptions options);
   int point_size() const override { return m_; }
   int dim() const override { return n_; }
-  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
+ protected:
+  void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
+
+ public:
   // The method's stage solves (zeros for explicit methods).
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }

@@ -41,8 +41,7 @@
 // unforced flow the construction is of order 2 whatever Psi and the rule (the free particle with
 // f = -c v: the unforced flow is the straight line, and the step becomes the Galerkin degree-1
 // map p1 = p0 (1 - ch/2)/(1 + ch/2) for every exact Psi and rule). Forces are applied in step()
-// only; evaluate() (varia ld) gives the unforced L_d. The time is set by set_time and advanced
-// by h per step. Not with the type-2 form nor with end-derivative quadratures.
+// only; evaluate() (varia ld) gives the unforced L_d. The time is the step's t0 (discrete_hamiltonian_map.hpp). Not with the type-2 form nor with end-derivative quadratures.
 //
 // On a Lie group (a manifold that is not a vector space; SO(3)-shaped, rotation_field.hpp) the same
 // construction runs in the natural charts (paper, sec. 2 "Natural charts", sec. 3): the jet
@@ -96,15 +95,16 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
                 double* D2) override;
   int point_size() const override { return m_; }
   int dim() const override { return n_; }
-  void step(const double* q0, const double* p0, double h, double* q1, double* p1) override;
   // The shooting Newton iteration (one solve per step or evaluation).
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   // The one-step method's stage solves (zeros for explicit methods).
   const SolverStatistics& stage_statistics() const { return stages_; }
   const EvaluationCounters& evaluations() const override;
-  void set_time(double t) override { t_ = t; }
   // Residual norms of the last shooting solve, one per iteration (quadratic convergence).
   const std::vector<double>& last_residuals() const { return residuals_; }
+
+ protected:
+  void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
 
  private:
   // What the Newton iteration on w0 drives to zero.
@@ -134,7 +134,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   int m_, n_;  // point_size, dim
   std::vector<double> nodes_, weights_;  // with 0 and 1 included
   double start_correction_ = 0.0, end_correction_ = 0.0;  // a_1, z_1 (Euler-Maclaurin)
-  double t_ = 0.0;       // the time at the start of the next step
+  double t_ = 0.0;       // the time at the start of the step being taken
   bool forced_ = false;  // forces applied in the current solve (steps of a forced system)
   bool target_is_end_ = false;  // B's chart at q^n's value (a step) or at target_ (evaluate)
   std::vector<double> target_, zero_ = std::vector<double>(kMaxJetVariables, 0.0);

@@ -15,35 +15,13 @@
 
 namespace varia {
 
-// What the parts declare, as the theorems need it.
-struct Composition {
-  enum class Construction { galerkin, shooting, one_step, lie_verlet } construction;
-  int quadrature_order = 0;            // degree of exactness + 1 (0: no quadrature)
-  bool quadrature_symmetric = false;
-  int degree = 0;                      // Galerkin interpolation degree s
-  bool control_times_symmetric = false;
-  bool natural_chart = false;          // Galerkin on a Lie group: interpolation in the chart at q0
-  int method_order = 0;                // one-step method order p
-  bool method_self_adjoint = false;
-  bool method_symplectic = false;      // declared by one-step plugins
-  bool method_equivariant = false;     // under the Lagrangian's symmetry
-  bool lagrangian_invariant = false;   // the Lagrangian declares a symmetry group
-  bool forced = false;                 // non-conservative forces (Lagrange-d'Alembert principle)
-};
-
+// What the theorems promise of a composed integrator (each construction states its own:
+// host/src/constructions/); null where they say nothing.
 struct Predictions {
   std::optional<bool> self_adjoint, g_invariant, momentum_conserved, symplectic, energy_bounded;
   std::optional<int> ld_order, global_order;
   std::string reason;  // the theorem each prediction comes from, for the report
 };
-
-// Galerkin (paper, sec. 2): order min(2s, quadrature order); self-adjoint for a symmetric rule and
-// symmetric control times on a vector space (the chart at q0 of a Lie group is not symmetric in
-// q0 and q1: no prediction there); G-invariant for an invariant L (equivariant natural-chart
-// interpolant).
-// Shooting (paper, sec. 3 theorem): order min(p, q); self-adjoint for a self-adjoint method and a
-// symmetric rule; G-invariant for a G-equivariant method and an invariant L.
-Predictions predict(const Composition& composition);
 
 // A least-squares slope of log(error) against log(h) that drops points at round-off (error below
 // `floor`), pre-asymptotic points (leading points whose local slope differs from the next by
@@ -77,9 +55,10 @@ void exact_discrete_lagrangian(LagrangianEvaluator& lagrangian, const double* no
                                const double* weights, int points, const double* q0,
                                const double* v0, double h, double* q1, double* LdE);
 
-// Runs `steps` steps of size h from (q, p), calling observe(k, q, p) at every step (k = 0 first).
+// Runs `steps` steps of size h from (q, p) at time t0 through the trajectory driver
+// (trajectory.hpp), calling observe(k, q, p) at every step (k = 0 first).
 using Observer = std::function<void(long, const double*, const double*)>;
-void run(DiscreteHamiltonianMap& map, std::vector<double> q, std::vector<double> p, double h,
+void run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::VectorXd& p, double t0, double h,
          long steps, const Observer& observe);
 
 // The one-step map's Jacobian M = d(xi1, pi1)/d(xi0, pi0) in canonical coordinates of T*Q (the

@@ -1,0 +1,36 @@
+#include "varia/core/trajectory.hpp"
+
+#include <cmath>
+
+namespace varia {
+
+Trajectory::Trajectory(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q0, const Eigen::VectorXd& p0,
+                       double t0, double h)
+    : map_(map), q_(q0), p_(p0), q1_(q0.size()), p1_(p0.size()), t0_(t0), h_(h) {}
+
+void Trajectory::step() {
+  const double t = time_of(steps_);
+  try {
+    map_.step(q_.data(), p_.data(), t, h_, q1_.data(), p1_.data());
+  } catch (const NumericalFailure& e) {
+    throw StepFailure(e.what(), e.residual(), steps_ + 1, t);
+  }
+  if (!q1_.allFinite() || !p1_.allFinite()) throw StepFailure("a non-finite state", std::nan(""), steps_ + 1, t);
+  q_.swap(q1_);
+  p_.swap(p1_);
+  ++steps_;
+}
+
+void Trajectory::advance(long count) {
+  const long last = steps_ + count;
+  try {
+    map_.advance(q_.data(), p_.data(), time_of(steps_), h_, count, q1_.data(), p1_.data());
+  } catch (const NumericalFailure& e) {
+    throw StepFailure(e.what(), e.residual(), last, time_of(last - 1));
+  }
+  if (!q_.allFinite() || !p_.allFinite())
+    throw StepFailure("a non-finite state", std::nan(""), last, time_of(last - 1));
+  steps_ = last;
+}
+
+}  // namespace varia

@@ -1,0 +1,58 @@
+// The one-step construction: no discrete Lagrangian; a one-step method integrates the
+// Euler-Lagrange equations directly (the comparison methods of the paper's Figure 1). Core:
+// varia/core/one_step_map.hpp.
+#include "construction.hpp"
+#include "parts.hpp"
+#include "varia/core/one_step_map.hpp"
+
+namespace varia::host {
+
+namespace {
+
+using nlohmann::json;
+
+class OneStep final : public Construction {
+ public:
+  const char* name() const override { return "one-step"; }
+
+  json schema() const override {
+    return method_schema(
+        "one-step", {{"one_step", plugin_schema("the one-step method, e.g. {\"type\": \"implicit-midpoint\"}")}},
+        {"one_step"});
+  }
+
+  std::shared_ptr<const MethodOptions> read(const json&) const override { return std::make_shared<MethodOptions>(); }
+
+  void build(const Scene& scene, Registry& registry, Assembly& a) const override {
+    make_one_step(scene, registry, a);
+    a.map = std::make_unique<OneStepHamiltonianMap>(*a.manifold, *a.lagrangian, *a.one_step, scene.solver);
+  }
+
+  // What the method declares: its order, self-adjointness and symplecticity; a symplectic method
+  // that commutes with the symmetry conserves its momentum map (no L_d, no G-invariance claim).
+  Predictions predict(const Scene& scene, const Assembly& a) const override {
+    const DeclaredMethod method = declared(scene, a);
+    Predictions p;
+    p.global_order = method.order;
+    p.self_adjoint = method.self_adjoint;
+    p.symplectic = method.symplectic;
+    if (method.symplectic) p.energy_bounded = true;
+    p.reason = "one-step method: its declared order, self-adjointness and symplecticity (no L_d)";
+    apply_shared_theorems(a, std::nullopt, p);
+    if (std::string(a.lagrangian->symmetry_group()) != "none" && method.symplectic && method.equivariant &&
+        a.forces.empty())
+      p.momentum_conserved = true;
+    return p;
+  }
+
+  std::string describe(const Scene& scene) const override { return describe_parts(scene, "one-step"); }
+};
+
+}  // namespace
+
+const Construction& one_step_construction() {
+  static const OneStep construction;
+  return construction;
+}
+
+}  // namespace varia::host

@@ -1,0 +1,63 @@
+#include "parts.hpp"
+
+namespace varia::host {
+
+void apply_shared_theorems(const Assembly& a, std::optional<bool> ld_invariant, Predictions& p) {
+  if (std::string(a.lagrangian->symmetry_group()) != "none") {
+    p.g_invariant = ld_invariant;
+    if (ld_invariant.value_or(false)) p.momentum_conserved = true;
+  }
+  if (!a.forces.empty()) {
+    p.symplectic.reset();
+    p.energy_bounded.reset();
+    p.momentum_conserved.reset();
+    p.reason += "; with forces the conservation theorems do not apply";
+  }
+}
+
+void make_one_step(const Scene& scene, Registry& registry, Assembly& a) {
+  a.one_step = make_part<OneStepMethod>(registry, *scene.one_step, scene, *a.manifold);
+  a.one_step->set_solver(scene.solver.tolerance, scene.solver.max_iterations);
+  a.one_step_symplectic = registry.find(scene.one_step->kind, scene.one_step->type).properties.value("symplectic", false);
+}
+
+DeclaredMethod declared(const Scene&, const Assembly& a) {
+  const std::string equivariance = a.one_step->equivariance();
+  return DeclaredMethod{a.one_step->order(), a.one_step->self_adjoint(), a.one_step_symplectic,
+                        equivariance == "affine" || equivariance == "left"};
+}
+
+nlohmann::json plugin_schema(const char* description) {
+  return {{"description", description},
+          {"type", "object"},
+          {"required", {"type"}},
+          {"properties", {{"type", {{"description", "the plugin's type name"}, {"type", "string"}}}}}};
+}
+
+nlohmann::json method_schema(const char* construction, nlohmann::json keys, std::vector<std::string> required) {
+  nlohmann::json properties = {
+      {"construction", {{"description", "the construction"}, {"const", construction}}},
+      {"solver",
+       {{"description", "{\"tolerance\": number > 0, \"max_iterations\": integer >= 1}: the nonlinear solver's options"},
+        {"type", "object"},
+        {"additionalProperties", false},
+        {"properties",
+         {{"tolerance", {{"description", "the Newton tolerance"}, {"type", "number"}, {"exclusiveMinimum", 0}}},
+          {"max_iterations",
+           {{"description", "the Newton iteration limit"}, {"type", "integer"}, {"minimum", 1}, {"maximum", 1000000}}}}}}}};
+  properties.update(keys);
+  required.insert(required.begin(), "construction");
+  return {{"description", std::string("the method of construction '") + construction + "'"},
+          {"type", "object"},
+          {"required", required},
+          {"additionalProperties", false},
+          {"properties", properties}};
+}
+
+std::string describe_parts(const Scene& scene, std::string words) {
+  if (scene.one_step) words += " with " + scene.one_step->type;
+  if (scene.quadrature) words += ", quadrature " + scene.quadrature->type + " " + scene.quadrature->parameters.dump();
+  return words;
+}
+
+}  // namespace varia::host
