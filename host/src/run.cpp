@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "interrupt.hpp"
 #include "observer.hpp"
 #include "output.hpp"
 #include "plot.hpp"
@@ -161,7 +162,7 @@ class Stepper {
     std::optional<Failure> failure;
     try {
       start_output();
-      while (state_.step < scene_.steps) {
+      while (state_.step < scene_.steps && interruption() == 0) {
         advance();
         progress.update(state_.step);
       }
@@ -173,7 +174,7 @@ class Stepper {
                     : Failure{state_.step + 1, state_.t, e.residual(), e.what()};
     }
     state_.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    if (csv_) csv_->flush();
+    if (csv_) csv_->close();
     return failure;
   }
 
@@ -237,14 +238,33 @@ json residual_json(double residual) {
 
 void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options) {
   Stepper stepper(scene, assembly, options);
-  const auto failure = stepper.run(options.quiet);
-  json record = run_record(scene, assembly, stepper.observer(), stepper.state(), registry);
+  // A plugin fault or an interruption also leaves a run record, noting it (docs/security.md).
+  const auto write_record = [&](const json& note) {
+    json record = run_record(scene, assembly, stepper.observer(), stepper.state(), registry);
+    for (const auto& [key, value] : note.items()) record[key] = value;
+    if (options.summary) write_json_file(*options.summary, record, "--summary");
+  };
+  std::optional<Failure> failure;
+  try {
+    failure = stepper.run(options.quiet);
+  } catch (const PluginFault& e) {
+    write_record({{"failure", {{"step", stepper.state().step + 1}, {"t", stepper.state().t}, {"plugin_fault", e.what()}}}});
+    throw;
+  }
+  if (const int signal = interruption(); signal != 0 && !failure) {
+    write_record({{"interrupted", {{"signal", signal_name(signal)}, {"steps_completed", stepper.state().step}}}});
+    throw Interrupted(signal, fmt::format("after step {} of {} (t = {:.10g}); the trajectory ends with that step's "
+                                          "row and the run record notes the interruption",
+                                          stepper.state().step, scene.steps, stepper.state().t));
+  }
   if (failure)
-    record["failure"] = {{"step", failure->step},
-                         {"t", failure->t},
-                         {"residual", residual_json(failure->residual)},
-                         {"message", failure->message}};
-  if (options.summary) write_json_file(*options.summary, record);
+    write_record({{"failure",
+                   {{"step", failure->step},
+                    {"t", failure->t},
+                    {"residual", residual_json(failure->residual)},
+                    {"message", failure->message}}}});
+  else
+    write_record(json::object());
   if (options.plot) stepper.plot()->write(*options.plot);
   if (failure)
     throw NumericalFailure(fmt::format("step {} (from t = {:.10g}) failed: {}; residual {:.3e}", failure->step,
