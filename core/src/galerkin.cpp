@@ -106,7 +106,7 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   impulse_.resize(n_);
   change_.resize((s_ + 1) * n_);
   q_.resize(n_);
-  v_.resize(n_);
+  v_ = Eigen::VectorXd::Zero(n_);  // the explicit form evaluates at v = 0, as its fixed-size path does
   velocity_ = Eigen::VectorXd::Zero(n_);
   grad_.resize(2 * n_);
   gradient_.resize((s_ + 1) * n_);

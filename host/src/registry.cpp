@@ -1,12 +1,17 @@
 #include "registry.hpp"
 
 #include <dlfcn.h>
+#include <elf.h>
 #include <sys/stat.h>
 #include <unistd.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <fstream>
+#include <optional>
 #include <cerrno>
 #include <cstring>
 #include <cstdlib>
@@ -248,17 +253,67 @@ const std::vector<fs::path>& Registry::candidates() {
   return *candidates_;
 }
 
+namespace {
+
+// The names in the dynamic symbol table (.dynsym) of an ELF64 file of this machine's byte order:
+// what the dynamic loader reads, so `strip` keeps it (boost::dll::library_info reads .symtab only).
+// None when the file is not such a file.
+std::optional<std::vector<std::string>> dynamic_symbols(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  Elf64_Ehdr header{};
+  constexpr unsigned char kByteOrder = std::endian::native == std::endian::little ? ELFDATA2LSB : ELFDATA2MSB;
+  if (!in.read(reinterpret_cast<char*>(&header), sizeof header) || std::memcmp(header.e_ident, ELFMAG, SELFMAG) != 0 ||
+      header.e_ident[EI_CLASS] != ELFCLASS64 || header.e_ident[EI_DATA] != kByteOrder ||
+      header.e_shentsize != sizeof(Elf64_Shdr))
+    return std::nullopt;
+  std::vector<Elf64_Shdr> sections(header.e_shnum);
+  in.seekg(static_cast<std::streamoff>(header.e_shoff));
+  if (!in.read(reinterpret_cast<char*>(sections.data()), static_cast<std::streamsize>(sections.size() * sizeof(Elf64_Shdr))))
+    return std::nullopt;
+  const auto contents = [&](const Elf64_Shdr& section) -> std::optional<std::string> {
+    constexpr std::uint64_t kMaxBytes = 64u << 20;
+    if (section.sh_size > kMaxBytes) return std::nullopt;
+    std::string bytes(section.sh_size, '\0');
+    in.seekg(static_cast<std::streamoff>(section.sh_offset));
+    if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) return std::nullopt;
+    return bytes;
+  };
+  std::vector<std::string> names;
+  for (const auto& section : sections) {
+    if (section.sh_type != SHT_DYNSYM || section.sh_link >= sections.size() || section.sh_entsize != sizeof(Elf64_Sym))
+      continue;
+    const auto table = contents(section), strings = contents(sections[section.sh_link]);
+    if (!table || !strings) return std::nullopt;
+    for (std::size_t at = 0; at + sizeof(Elf64_Sym) <= table->size(); at += sizeof(Elf64_Sym)) {
+      Elf64_Sym symbol{};
+      std::memcpy(&symbol, table->data() + at, sizeof symbol);
+      if (symbol.st_name < strings->size())
+        names.emplace_back(strings->data() + symbol.st_name, strnlen(strings->data() + symbol.st_name,
+                                                                      strings->size() - symbol.st_name));
+    }
+  }
+  return names;
+}
+
+}  // namespace
+
 const SymbolScan& Registry::scan(const fs::path& file) {
   auto [it, inserted] = scans_.try_emplace(file);
   if (!inserted) return it->second;
   SymbolScan& result = it->second;
-  try {
-    boost::dll::library_info info(file, false);
-    const auto symbols = info.symbols();
+  const auto read = [&](const auto& symbols) {
     result.parsed = true;
     result.has_symbol_table = !symbols.empty();
     for (const auto& symbol : symbols)
       if (auto marker = parse_marker(symbol)) result.markers.push_back(std::move(*marker));
+  };
+  if (const auto names = dynamic_symbols(file)) {
+    read(*names);
+    return result;
+  }
+  try {  // not ELF64: what boost::dll can read
+    boost::dll::library_info info(file, false);
+    read(info.symbols());
   } catch (const std::exception&) {
     result.parsed = false;  // reported by list(); find() skips it
   }

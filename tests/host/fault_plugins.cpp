@@ -193,5 +193,18 @@ TEST_CASE("plugins behind a link, under a writable parent or owned by another us
   }
 }
 
+TEST_CASE("a plugin whose type no scene names is never loaded, stripped or not") {
+  for (const bool stripped : {false, true}) {
+    CAPTURE(stripped);
+    TempDir dir;
+    const auto plugin = dir / "fault_aborts_on_load.so";
+    fs::copy_file(fs::path(VARIA_ABORTING_PLUGIN_DIR) / "fault_aborts_on_load.so", plugin);
+    if (stripped) REQUIRE(std::system(("strip --strip-all '" + plugin.string() + "'").c_str()) == 0);
+    const auto outcome = run_varia("run scenes/default.json --quiet --plugin-path '" + dir.path().string() + "'");
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == 0);
+  }
+}
+
 }  // namespace
 }  // namespace varia::test
