@@ -14,6 +14,7 @@
 
 #include "commands.hpp"
 #include "cost.hpp"
+#include "crash.hpp"
 #include "errors.hpp"
 #include "interrupt.hpp"
 #include "output.hpp"
@@ -220,6 +221,7 @@ std::string command_names(const CLI::App& app) {
 int main_cli(int argc, char** argv) {
   open_standard_descriptors();
   install_interrupt_handlers();
+  install_crash_handlers();
   CLI::App app{"varia: variational integrators built from runtime-loaded plugins."};
   app.set_version_flag("--version", VARIA_VERSION);
   app.require_subcommand(1);

@@ -24,6 +24,7 @@
 #include <boost/dll/runtime_symbol_info.hpp>
 #include <boost/dll/shared_library.hpp>
 
+#include "crash.hpp"
 #include "json_schema.hpp"
 
 namespace fs = std::filesystem;
@@ -192,6 +193,7 @@ std::shared_ptr<Registry::Loaded> Registry::load(const fs::path& file, const Sym
   try {
     if (!scan.parsed) throw Refused{"not a shared library (its format cannot be read)"};
     auto loaded = std::make_shared<Loaded>();
+    note_plugin_file(file);  // before its code runs: a crash in its initializers is named too
     loaded->library = open_library(file);
     check_abi(*loaded->library);
     loaded->record = read_info(*loaded->library, file);

@@ -206,5 +206,19 @@ TEST_CASE("a plugin whose type no scene names is never loaded, stripped or not")
   }
 }
 
+TEST_CASE("a plugin that crashes varia is named on stderr") {
+  TempDir dir;
+  fs::copy_file(fs::path(VARIA_ABORTING_PLUGIN_DIR) / "fault_aborts_on_load.so", dir / "fault_aborts_on_load.so");
+  const auto outcome = run_varia("plugins --plugin-path '" + dir.path().string() + "'");
+  CHECK(outcome.code != 0);
+  // One line from varia (the shell that ran it may add its own "Aborted" after it).
+  const auto lines = lines_of(outcome.err);
+  CAPTURE(outcome.err);
+  REQUIRE(!lines.empty());
+  CHECK(std::count_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("varia:", 0) == 0; }) == 1);
+  CHECK(contains(lines[0], "varia: error: plugin fault: fatal signal SIGABRT (abort) in a call to the plugin "));
+  CHECK(contains(lines[0], "fault_aborts_on_load.so"));
+}
+
 }  // namespace
 }  // namespace varia::test
