@@ -125,7 +125,10 @@ void run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::Vec
          long steps, const Observer& observe) {
   Trajectory trajectory(map, q, p, t0, h);
   observe(0, q.data(), p.data());
-  trajectory.run_to(steps, [&](const Trajectory& x) { observe(x.steps(), x.q().data(), x.p().data()); });
+  trajectory.run_to(steps, [&](const Trajectory& x) {
+    observe(x.steps(), x.q().data(), x.p().data());
+    return true;
+  });
 }
 
 namespace {

@@ -3,12 +3,21 @@
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <fcntl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdio>
 #include <functional>
 #include <new>
+#include <system_error>
 
 #include "commands.hpp"
 #include "cost.hpp"
+#include "crash.hpp"
 #include "errors.hpp"
+#include "interrupt.hpp"
+#include "output.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/core/plugin_object.hpp"
 
@@ -16,18 +25,50 @@ namespace varia::host {
 
 namespace {
 
-// One line, whatever the message holds.
+// One line, whatever the message holds: control characters (newlines, terminal escapes, NUL)
+// shown as \xNN, and text quoted from the input cut to a bounded length. Never throws: a closed
+// or full stderr loses the message, not the exit code.
 void report(const std::string& message) {
-  std::string line = message;
-  for (char& c : line)
-    if (c == '\n' || c == '\r') c = ' ';
-  fmt::print(stderr, "varia: error: {}\n", line);
+  constexpr std::size_t kMaxShown = 2000;
+  std::string line = "varia: error: ";
+  for (std::size_t i = 0; i < message.size() && i < kMaxShown; ++i) {
+    const auto c = static_cast<unsigned char>(message[i]);
+    if (c < 0x20 || c == 0x7f)
+      line += fmt::format("\\x{:02x}", c);
+    else
+      line += static_cast<char>(c);
+  }
+  if (message.size() > kMaxShown) line += fmt::format("... ({} more bytes)", message.size() - kMaxShown);
+  line += '\n';
+  (void)std::fwrite(line.data(), 1, line.size(), stderr);
+  (void)std::fflush(stderr);
+}
+
+// Standard descriptors that the caller closed are opened (stdin and stderr on /dev/null, stdout
+// on /dev/full, so results written there fail loudly), so that no output file takes their
+// number and receives diagnostics.
+void open_standard_descriptors() {
+  const char* devices[] = {"/dev/null", "/dev/full", "/dev/null"};
+  for (int fd = 0; fd <= 2; ++fd)
+    if (::fcntl(fd, F_GETFD) < 0 && errno == EBADF) {
+      const int opened = ::open(devices[fd], fd == 0 ? O_RDONLY : O_WRONLY);
+      if (opened >= 0 && opened != fd) {
+        ::dup2(opened, fd);
+        ::close(opened);
+      }
+    }
 }
 
 // Spec "Exit codes": 2 bad input, 3 plugin fault, 4 numerical failure.
 int guarded(const std::function<int()>& command) {
   try {
-    return command();
+    const int code = command();
+    check_stdout();
+    stop_if_interrupted("at the end of the command");
+    return code;
+  } catch (const Interrupted& e) {
+    report(e.what());
+    return 128 + e.signal();
   } catch (const InputError& e) {
     report(e.what());
     return kExitInput;
@@ -40,12 +81,15 @@ int guarded(const std::function<int()>& command) {
   } catch (const NumericalFailure& e) {
     report(fmt::format("numerical failure: {}", e.what()));
     return kExitNumerical;
+  } catch (const std::system_error& e) {  // fmt printing to a stdout or stderr that refuses it
+    report(fmt::format("stdout or stderr: the results cannot be written: {}", e.what()));
+    return kExitInput;
   } catch (const std::invalid_argument& e) {  // a core constructor refusing its arguments
     report(e.what());
     return kExitInput;
-  } catch (const std::bad_alloc&) {
-    report("out of memory");
-    return kExitNumerical;
+  } catch (const std::bad_alloc&) {  // not a numerical failure: what was asked for is too large
+    report("out of memory: the scene or the flags ask for more memory than this machine gives");
+    return kExitInput;
   } catch (const std::exception& e) {
     report(fmt::format("unexpected failure: {}", e.what()));
     return kExitPlugin;
@@ -175,6 +219,9 @@ std::string command_names(const CLI::App& app) {
 }  // namespace
 
 int main_cli(int argc, char** argv) {
+  open_standard_descriptors();
+  install_interrupt_handlers();
+  install_crash_handlers();
   CLI::App app{"varia: variational integrators built from runtime-loaded plugins."};
   app.set_version_flag("--version", VARIA_VERSION);
   app.require_subcommand(1);

@@ -136,6 +136,17 @@ Eigen::VectorXd parse_numbers(const std::string& text, int expected, const char*
   return Eigen::Map<const Eigen::VectorXd>(values.data(), expected);
 }
 
+// A point of the manifold, checked as the scene's initial point is (scene.cpp).
+Eigen::VectorXd parse_point(const std::string& text, Manifold& manifold, const std::string& manifold_type,
+                            const char* flag) {
+  Eigen::VectorXd q = parse_numbers(text, manifold.point_size(), flag);
+  char why[256] = {};
+  if (!manifold.contains(q.data(), why, sizeof why))
+    throw InputError(fmt::format("{}: expected a point of {}{}{}; found '{}'", flag, manifold_type, why[0] ? ": " : "",
+                                 why, text));
+  return q;
+}
+
 }  // namespace
 
 int command_plugins(const CommonOptions& common, bool as_json) {
@@ -163,6 +174,11 @@ int command_validate(const CommonOptions& common, const std::string& scene_file)
 }
 
 int command_run(const CommonOptions& common, const std::string& scene_file, const RunOptions& options) {
+  std::vector<NamedFile> outputs;
+  for (const auto& [flag, file] : {std::pair{"--out", options.out}, {"--summary", options.summary},
+                                   {"--plot", options.plot}})
+    if (file) outputs.push_back({flag, *file});
+  check_distinct({{"scene", scene_file}}, outputs);
   return with_registry(common, [&](Registry& registry) {
     Prepared prepared = prepare(scene_file, registry);
     run_scene(prepared.scene, prepared.assembly, registry, options);
@@ -179,11 +195,17 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
                                    scene_file, prepared.scene.construction->name()));
     if (!(options.h > 0.0) || !std::isfinite(options.h))
       throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
-    const Eigen::VectorXd q0 = parse_numbers(options.q0, a.map->point_size(), "--q0");
-    const Eigen::VectorXd q1 = parse_numbers(options.q1, a.map->point_size(), "--q1");
+    const Eigen::VectorXd q0 = parse_point(options.q0, *a.manifold, prepared.scene.manifold.type, "--q0");
+    const Eigen::VectorXd q1 = parse_point(options.q1, *a.manifold, prepared.scene.manifold.type, "--q1");
     double ld = 0.0;
     Eigen::VectorXd d1(a.map->dim()), d2(a.map->dim());
     a.discrete_lagrangian->evaluate(q0.data(), q1.data(), options.h, &ld, d1.data(), d2.data());
+    if (!std::isfinite(ld) || !d1.allFinite() || !d2.allFinite())  // as run does with a non-finite state
+      throw NumericalFailure(fmt::format("a non-finite value of L_d or its derivatives at --q0 {} --q1 {} --h {} "
+                                         "(Ld = {}, D1 = [{}], D2 = [{}])",
+                                         options.q0, options.q1, options.h, ld, fmt::join(as_vector(d1), ", "),
+                                         fmt::join(as_vector(d2), ", ")),
+                             std::nan(""));
     if (options.json) {
       const nlohmann::ordered_json result{{"Ld", ld}, {"D1", as_vector(d1)}, {"D2", as_vector(d2)}};
       fmt::print("{}\n", result.dump());
@@ -196,11 +218,12 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
 }
 
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file) {
+  if (!json_file.empty()) check_distinct({{"scene", scene_file}}, {{"--json", json_file}});
   return with_registry(common, [&](Registry& registry) {
     Prepared prepared = prepare(scene_file, registry);
     const auto checks = verify_scene(prepared.scene, prepared.assembly, registry);
     fmt::print("{}", checks_table(checks));
-    if (!json_file.empty()) write_json_file(json_file, nlohmann::ordered_json(checks_json(checks)));
+    if (!json_file.empty()) write_json_file(json_file, nlohmann::ordered_json(checks_json(checks)), "--json");
     const long failures = std::count_if(checks.begin(), checks.end(), [](const auto& c) { return c.failed(); });
     if (failures == 0) return 0;
     std::vector<std::string> names;

@@ -14,6 +14,7 @@
 
 #include "assemble.hpp"
 #include "errors.hpp"
+#include "interrupt.hpp"
 #include "observer.hpp"
 #include "output.hpp"
 #include "plot.hpp"
@@ -36,6 +37,9 @@ constexpr long kEnergySamples = 1000;
 // single short run is dominated by timer resolution and cold caches.
 constexpr double kShortRun = 0.05;
 constexpr int kMaxRepeats = 20;
+// A run of the sweep takes at most this many steps (`--h` is refused below t_end / kMaxSteps): the
+// sweep repeats its short runs and times every run, and a step costs microseconds.
+constexpr double kMaxSteps = 1e8;
 // The default sweep: the scene's step times 2^2, 2^1, ..., 2^-4 (7 step sizes, 6 halvings).
 constexpr int kSweepAbove = 2, kSweepBelow = 4;
 
@@ -195,6 +199,7 @@ void progress(const CostOptions& options, const std::string& text) {
 void sweep(Method& m, const CostOptions& options, int index, int count) {
   const double t_end = final_time(m.scene);
   for (double h : step_sizes(m.scene, options)) {
+    stop_if_interrupted(fmt::format("during the sweep of {}", m.name));
     const long steps = steps_for(t_end, h);
     progress(options, fmt::format("varia: cost: method {} of {} ({}), h = {:.4g}, {} steps", index + 1, count,
                                   m.name, t_end / steps, steps));
@@ -217,6 +222,33 @@ void fit(Method& m) {
 
 // ---- outputs ----------------------------------------------------------------------------------
 
+// --out names a directory (made if missing) whose cost.csv, cost.json and cost.svg are none of the
+// scene files.
+void check_cost_outputs(const std::vector<std::string>& scene_files, const std::filesystem::path& out) {
+  std::error_code ec;
+  std::filesystem::create_directories(out, ec);
+  if (!std::filesystem::is_directory(out))
+    throw InputError(fmt::format("--out {}: expected a directory (or a path where one can be made){}", out.string(),
+                                 ec ? ": " + ec.message() : ""));
+  std::vector<NamedFile> inputs;
+  for (const auto& file : scene_files) inputs.push_back({"scene", file});
+  check_distinct(inputs, {{"--out", out / "cost.csv"}, {"--out", out / "cost.json"}, {"--out", out / "cost.svg"}});
+}
+
+// Every step size of the sweep gives a number of steps the scene reader would accept (at least
+// one step of at most t_end, at most kMaxSteps).
+void check_step_sizes(const Method& m, const std::vector<double>& flags) {
+  const double t_end = final_time(m.scene);
+  for (double h : flags) {
+    if (!(h > 0.0) || !std::isfinite(h)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", h));
+    if (h > t_end)
+      throw InputError(fmt::format("--h: expected step sizes at most t_end = {} of {}; found {}", t_end, m.file, h));
+    if (t_end / h > kMaxSteps)
+      throw InputError(fmt::format("--h: expected at most {:g} steps to t_end = {} of {}; h = {} gives {:g}",
+                                   kMaxSteps, t_end, m.file, h, t_end / h));
+  }
+}
+
 std::string csv_field(const std::string& text) {
   if (text.find_first_of(",\"\n") == std::string::npos) return text;
   std::string quoted = "\"";
@@ -230,10 +262,7 @@ void write_csv(const std::filesystem::path& file, const std::deque<Method>& meth
     for (const Row& r : m.rows)
       text += fmt::format("{},{},{},{:.6e},{:.6e},{:.6e},{},{}\n", csv_field(m.name), r.h, r.steps, r.error,
                           r.energy_error, r.seconds, r.newton_iterations, r.evaluations);
-  std::FILE* out = std::fopen(file.c_str(), "w");
-  if (out == nullptr) throw InputError(fmt::format("--out: cannot write {}", file.string()));
-  std::fputs(text.c_str(), out);
-  std::fclose(out);
+  write_output(file, text, "--out");
 }
 
 json method_record(const Method& m) {
@@ -309,11 +338,11 @@ TimedRun run_timed(const Assembly& a, double h, long steps, Observer* observer) 
 
 int command_cost(const CommonOptions& common, const std::vector<std::string>& scene_files,
                  const CostOptions& options) {
-  for (double h : options.h)
-    if (!(h > 0.0) || !std::isfinite(h)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", h));
+  check_cost_outputs(scene_files, options.out);
   Registry registry(Registry::search_path(common.plugin_paths));
   std::deque<Method> methods;  // a deque: an Assembly stays where it was built
   for (const auto& file : scene_files) load_method(file, registry, methods);
+  for (const Method& m : methods) check_step_sizes(m, options.h);
 
   std::map<std::string, Truth> truths;
   for (Method& m : methods) {
@@ -330,7 +359,6 @@ int command_cost(const CommonOptions& common, const std::vector<std::string>& sc
                                                          static_cast<int>(methods.size()));
   progress(options, "");
 
-  std::filesystem::create_directories(options.out);
   json record{{"methods", json::array()}};
   for (Method& m : methods) {
     fit(m);
@@ -338,7 +366,7 @@ int command_cost(const CommonOptions& common, const std::vector<std::string>& sc
     if (!options.quiet) print_table(m);
   }
   write_csv(options.out / "cost.csv", methods);
-  write_json_file(options.out / "cost.json", record);
+  write_json_file(options.out / "cost.json", record, "--out");
   write_plot(options.out / "cost.svg", methods);
   if (!options.quiet) fmt::print("wrote {}, cost.svg, cost.json\n", (options.out / "cost.csv").string());
   return 0;

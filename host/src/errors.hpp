@@ -13,6 +13,14 @@ class InputError : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+// An output that cannot be written or closed (a full disk, a missing directory, a file another
+// run is writing): exit code 2 like an unwritable --out, the message naming the file
+// (docs/security.md, "Outputs").
+class OutputError : public InputError {
+ public:
+  using InputError::InputError;
+};
+
 // A plugin that cannot be loaded or misbehaves (exit code 3): the message names the file.
 // (varia::PluginFault from core is the same exit code.)
 class PluginLoadError : public std::runtime_error {

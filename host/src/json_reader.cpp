@@ -5,7 +5,10 @@
 #include <cerrno>
 #include <cmath>
 #include <cstring>
+#include <cstdint>
 #include <fstream>
+#include <limits>
+#include <set>
 #include <vector>
 
 #include "errors.hpp"
@@ -59,6 +62,10 @@ class Checker final : public json::json_sax_t {
   bool number_float(number_float_t value, const string_t& text) override {
     enter();
     if (!std::isfinite(value)) return out_of_range(text);
+    if (value != 0.0 && std::abs(value) < std::numeric_limits<double>::min())
+      return fail(fmt::format("{}: expected 0 or a number of magnitude at least {:g} (below it a double loses "
+                              "precision); found {}",
+                              shown(pointer_), std::numeric_limits<double>::min(), text.substr(0, 40)));
     leave();
     return true;
   }
@@ -67,6 +74,8 @@ class Checker final : public json::json_sax_t {
   bool start_object(std::size_t) override { return open(false); }
   bool key(string_t& name) override {
     pointer_.push_back(name);
+    if (!frames_.back().keys.insert(name).second)
+      return fail(fmt::format("{}: a repeated key; expected each key once in an object", shown(pointer_)));
     return true;
   }
   bool end_object() override { return close(); }
@@ -86,6 +95,7 @@ class Checker final : public json::json_sax_t {
   struct Frame {
     bool array;
     std::size_t next_index = 0;
+    std::set<std::string> keys;  // of an object, so far
   };
 
   // A value starts: in an array its index joins the pointer (in an object, key() added its name).
@@ -106,7 +116,7 @@ class Checker final : public json::json_sax_t {
     if (frames_.size() >= kMaxJsonDepth)
       return fail(fmt::format("{}: nested too deep; expected at most {} levels of objects and arrays",
                               shown(pointer_), kMaxJsonDepth));
-    frames_.push_back(Frame{array});
+    frames_.push_back(Frame{array, 0, {}});
     return true;
   }
   bool close() {
@@ -154,9 +164,23 @@ std::string read_bounded(const std::filesystem::path& file) {
 }  // namespace
 
 json parse_json_text(const std::string& text) {
+  // nlohmann ends its input at a NUL byte: what follows one would go unread.
+  if (const auto nul = text.find('\0'); nul != std::string::npos) {
+    const auto [line, column] = line_and_column(text, nul);
+    throw InputError(fmt::format("invalid JSON at line {}, column {}: a NUL byte; expected JSON text", line, column));
+  }
   Checker checker(text);
   if (!json::sax_parse(text, &checker) || !checker.error().empty()) throw InputError(checker.error().empty() ? "invalid JSON" : checker.error());
-  return json::parse(text);
+  // A number with a fraction part of zero (1.0) is an integer where the schemas ask for one.
+  return json::parse(text, [](int, json::parse_event_t event, json& value) {
+    if (event == json::parse_event_t::value && value.is_number_float()) {
+      const double x = value.get<double>();
+      constexpr double kExactIntegers = 9007199254740992.0;  // 2^53
+      if (x == std::trunc(x) && std::abs(x) <= kExactIntegers && !(x == 0.0 && std::signbit(x)))
+        value = static_cast<std::int64_t>(x);
+    }
+    return true;
+  });
 }
 
 json read_json_file(const std::filesystem::path& file) { return parse_json_text(read_bounded(file)); }

@@ -3,7 +3,10 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <set>
 #include <string_view>
+// valijson reports an unusable schema by an exception (else it aborts the program).
+#define VALIJSON_USE_EXCEPTIONS 1
 #include <valijson/adapters/nlohmann_json_adapter.hpp>
 #include <valijson/schema.hpp>
 #include <valijson/schema_parser.hpp>
@@ -209,7 +212,64 @@ std::string message(const json& document, const json& instance, const Violation&
   return fmt::format("{}: expected {}{}", pointer, expected, found.empty() ? "" : "; found " + found);
 }
 
+// ---- what valijson is not given ------------------------------------------------------------------
+
+// Keywords a plugin's parameter schema may not use: references (remote ones would be fetched, a
+// self reference recurses without end) and regular expressions (std::regex's matching time and
+// stack depth are unbounded in the input's length). docs/security.md, "Plugins".
+void check_plugin_schema(const json& node, const std::string& pointer) {
+  if (node.is_boolean()) return;
+  if (!node.is_object()) throw std::invalid_argument(fmt::format("{}: expected a schema (an object)", pointer));
+  static const std::set<std::string> refused{"$ref", "$id", "id", "pattern", "patternProperties", "format"};
+  static const std::set<std::string> schema_maps{"properties", "definitions", "$defs", "dependencies"};
+  static const std::set<std::string> schema_values{"items", "additionalItems", "additionalProperties", "not",
+                                                   "contains", "propertyNames", "if", "then", "else",
+                                                   "allOf", "anyOf", "oneOf"};
+  for (const auto& [key, value] : node.items()) {
+    const std::string at = pointer + "/" + escape_token(key);
+    if (refused.count(key) != 0)
+      throw std::invalid_argument(fmt::format("{}: the keyword '{}' is not allowed in a parameter schema", at, key));
+    if (schema_maps.count(key) != 0 && value.is_object())
+      for (const auto& [name, schema] : value.items())
+        if (!schema.is_array()) check_plugin_schema(schema, at + "/" + escape_token(name));
+    if (schema_values.count(key) != 0) {
+      if (value.is_array())
+        for (std::size_t i = 0; i < value.size(); ++i) check_plugin_schema(value[i], fmt::format("{}/{}", at, i));
+      else
+        check_plugin_schema(value, at);
+    }
+  }
+}
+
+// Arrays whose schema asks for unique items are checked here, in n log n, before valijson (which
+// compares every pair and records an error for each pair of duplicates).
+void check_unique_items(const json& document, const json& instance, std::vector<std::string>& tokens,
+                        const std::string& prefix) {
+  if (instance.is_object()) {
+    for (const auto& [key, value] : instance.items()) {
+      tokens.push_back(key);
+      check_unique_items(document, value, tokens, prefix);
+      tokens.pop_back();
+    }
+    return;
+  }
+  if (!instance.is_array()) return;
+  const json* schema = resolve(document, schema_at(document, tokens, tokens.size()));
+  const bool unique = schema != nullptr && schema->is_object() && schema->value("uniqueItems", false) == true;
+  std::set<json> seen;
+  for (std::size_t i = 0; i < instance.size(); ++i) {
+    tokens.push_back(std::to_string(i));
+    if (unique && !seen.insert(instance[i]).second)
+      throw InputError(fmt::format("{}{}: a repeated item ({}); expected items that are all different", prefix,
+                                   pointer_of(tokens, tokens.size()), brief(instance[i])));
+    check_unique_items(document, instance[i], tokens, prefix);
+    tokens.pop_back();
+  }
+}
+
 }  // namespace
+
+void check_parameter_schema(const json& schema) { check_plugin_schema(schema, ""); }
 
 std::string brief(const json& value) {
   std::string text = value.dump();
@@ -233,10 +293,13 @@ SchemaValidator::~SchemaValidator() = default;
 SchemaValidator::SchemaValidator(SchemaValidator&&) noexcept = default;
 
 void SchemaValidator::validate(const json& instance, const std::string& prefix) const {
+  std::vector<std::string> tokens;
+  check_unique_items(impl_->document, instance, tokens, prefix);
   valijson::Validator validator;
-  valijson::ValidationResults results;
   valijson::adapters::NlohmannJsonAdapter adapter(instance);
-  if (validator.validate(impl_->schema, adapter, &results)) return;
+  if (validator.validate(impl_->schema, adapter, nullptr)) return;  // stops at the first violation
+  valijson::ValidationResults results;
+  validator.validate(impl_->schema, adapter, &results);
   throw InputError(message(impl_->document, instance, most_specific(results), prefix));
 }
 

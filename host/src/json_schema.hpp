@@ -24,6 +24,10 @@ class SchemaValidator {
   std::unique_ptr<Impl> impl_;
 };
 
+// Throws std::invalid_argument when a plugin's parameter schema uses what the host does not give
+// valijson: references ($ref, $id) and regular expressions (pattern, patternProperties, format).
+void check_parameter_schema(const nlohmann::json& schema);
+
 // A short rendering of a JSON value for messages ("found ...").
 std::string brief(const nlohmann::json& value);
 

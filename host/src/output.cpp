@@ -1,8 +1,14 @@
 #include "output.hpp"
 
+#include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <cerrno>
+#include <cstdio>
 #include <cstring>
-#include <fstream>
+#include <optional>
 
 #include <fmt/ranges.h>
 
@@ -10,24 +16,141 @@
 
 namespace varia::host {
 
+namespace fs = std::filesystem;
+
 namespace {
+
 constexpr std::size_t kFlushBytes = 1 << 16;  // write to the file in chunks of whole rows
+
+// Writes all of `text` to `fd` (retrying short writes and interrupted calls); false with errno set
+// when the system refuses part of it, `done` then telling how much it took.
+bool write_all(int fd, std::string_view text, std::size_t& done) {
+  done = 0;
+  while (done < text.size()) {
+    const ssize_t written = ::write(fd, text.data() + done, text.size() - done);
+    if (written < 0 && errno == EINTR) continue;
+    if (written <= 0) {
+      if (written == 0) errno = EIO;
+      return false;
+    }
+    done += static_cast<std::size_t>(written);
+  }
+  return true;
 }
 
-CsvWriter::CsvWriter(const std::filesystem::path& file) {
+bool write_all(int fd, std::string_view text) {
+  std::size_t done = 0;
+  return write_all(fd, text, done);
+}
+
+[[noreturn]] void fail(std::string_view what, const fs::path& file, std::string_view doing, int error) {
+  throw OutputError(fmt::format("{} {}: cannot be {}: {}", what, file.string(), doing, std::strerror(error)));
+}
+
+// The mode a new file gets from open(2) with 0666: what the umask leaves.
+mode_t default_file_mode() {
+  const mode_t mask = ::umask(0);
+  ::umask(mask);
+  return 0666 & ~mask;
+}
+
+// Writes `text` to a temporary file in the directory of `target` and renames it over `target`.
+void replace_file(const fs::path& target, std::string_view text, std::string_view what) {
+  struct stat existing {};
+  const bool exists = ::stat(target.c_str(), &existing) == 0;
+  const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::string temporary = (directory / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  const int fd = ::mkstemp(temporary.data());
+  if (fd < 0) fail(what, target, "written", errno);
+  const auto abandon = [&](int error) {
+    ::close(fd);
+    ::unlink(temporary.c_str());
+    fail(what, target, "written", error);
+  };
+  if (::fchmod(fd, exists ? existing.st_mode & 07777 : default_file_mode()) != 0) abandon(errno);
+  if (!write_all(fd, text)) abandon(errno);
+  if (::close(fd) != 0) {
+    const int error = errno;
+    ::unlink(temporary.c_str());
+    fail(what, target, "written", error);
+  }
+  if (::rename(temporary.c_str(), target.c_str()) != 0) {
+    const int error = errno;
+    ::unlink(temporary.c_str());
+    fail(what, target, "written", error);
+  }
+}
+
+// A device or a pipe: written in place.
+void write_in_place(const fs::path& file, std::string_view text, std::string_view what) {
+  const int fd = ::open(file.c_str(), O_WRONLY | O_TRUNC | O_CLOEXEC);
+  if (fd < 0) fail(what, file, "opened", errno);
+  if (!write_all(fd, text)) {
+    const int error = errno;
+    ::close(fd);
+    fail(what, file, "written", error);
+  }
+  if (::close(fd) != 0) fail(what, file, "written", errno);
+}
+
+// The identity of an existing file, or none.
+std::optional<std::pair<dev_t, ino_t>> identity(const fs::path& file) {
+  struct stat status {};
+  if (::stat(file.c_str(), &status) != 0) return std::nullopt;
+  return std::pair{status.st_dev, status.st_ino};
+}
+
+bool is_device(const fs::path& file) {
+  struct stat status {};
+  return ::stat(file.c_str(), &status) == 0 && (S_ISCHR(status.st_mode) || S_ISBLK(status.st_mode));
+}
+
+bool same_file(const fs::path& a, const fs::path& b) {
+  if ((a == "-") != (b == "-")) return false;
+  if (a == "-") return true;
+  if (is_device(a) || is_device(b)) return false;
+  const auto ia = identity(a), ib = identity(b);
+  if (ia && ib) return *ia == *ib;
+  std::error_code ec;
+  return fs::weakly_canonical(a, ec) == fs::weakly_canonical(b, ec);
+}
+
+}  // namespace
+
+CsvWriter::CsvWriter(const fs::path& file) : name_(file.string()) {
   if (file == "-") {
-    file_ = stdout;
+    fd_ = STDOUT_FILENO;
     return;
   }
-  file_ = std::fopen(file.c_str(), "wb");
-  if (file_ == nullptr)
-    throw InputError(fmt::format("--out {}: cannot be written: {}", file.string(), std::strerror(errno)));
+  // Not truncated on opening: a file that another run is writing is refused before it is touched.
+  fd_ = ::open(file.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0666);
+  if (fd_ < 0) fail("--out", file, "written", errno);
   owned_ = true;
+  struct stat status {};
+  regular_ = ::fstat(fd_, &status) == 0 && S_ISREG(status.st_mode);
+  if (!regular_) return;
+  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    if (error == EWOULDBLOCK)
+      throw OutputError(fmt::format("--out {}: another run is writing this file; expected a file of its own",
+                                    name_));
+    fail("--out", file, "locked", error);
+  }
+  if (::ftruncate(fd_, 0) != 0) {
+    const int error = errno;
+    ::close(fd_);
+    fail("--out", file, "truncated", error);
+  }
 }
 
 CsvWriter::~CsvWriter() {
-  flush();
-  if (owned_) std::fclose(file_);
+  if (fd_ < 0) return;
+  try {
+    flush();
+  } catch (const OutputError&) {
+  }
+  if (owned_) ::close(fd_);
 }
 
 void CsvWriter::header(const std::vector<std::string>& columns) {
@@ -51,20 +174,62 @@ void CsvWriter::end_row() {
 }
 
 void CsvWriter::flush() {
-  if (buffer_.size() > 0) std::fwrite(buffer_.data(), 1, buffer_.size(), file_);
+  if (failed_ || buffer_.size() == 0) return;
+  const std::string_view rows(buffer_.data(), buffer_.size());
   buffer_.clear();
-  std::fflush(file_);
+  std::size_t done = 0;
+  if (!write_all(fd_, rows, done)) {
+    const int error = errno;
+    failed_ = true;
+    // A row cut part-way is taken back: the file keeps the whole rows that reached it.
+    const auto last_newline = rows.substr(0, done).rfind('\n');
+    if (regular_) (void)::ftruncate(fd_, whole_ + (last_newline == std::string_view::npos ? 0 : static_cast<off_t>(last_newline + 1)));
+    throw OutputError(fmt::format("--out {}: cannot be written: {}; it ends with the last whole row written",
+                                  name_, std::strerror(error)));
+  }
+  whole_ += static_cast<off_t>(rows.size());
 }
 
-void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_json& document) {
-  const std::string text = document.dump(2) + "\n";
+void CsvWriter::close() {
+  flush();
+  const int fd = fd_;
+  fd_ = -1;
+  if (owned_ && ::close(fd) != 0) fail("--out", name_, "written", errno);
+}
+
+void write_output(const fs::path& file, std::string_view text, std::string_view what) {
   if (file == "-") {
-    std::fwrite(text.data(), 1, text.size(), stdout);
+    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
+      fail(what, "(stdout)", "written", errno);
     return;
   }
-  std::ofstream out(file, std::ios::binary);
-  out << text;
-  if (!out) throw InputError(fmt::format("{}: cannot be written: {}", file.string(), std::strerror(errno)));
+  std::error_code ec;
+  const auto status = fs::status(file, ec);
+  if (fs::exists(status) && !fs::is_regular_file(status)) return write_in_place(file, text, what);
+  // A symbolic link keeps pointing where it did: its target is replaced.
+  replace_file(fs::exists(status) ? fs::canonical(file, ec) : file, text, what);
+}
+
+void write_json_file(const fs::path& file, const nlohmann::ordered_json& document, std::string_view what) {
+  write_output(file, document.dump(2) + "\n", what);
+}
+
+void check_stdout() {
+  if (std::fflush(stdout) != 0 || std::ferror(stdout))
+    throw OutputError(fmt::format("stdout: the results cannot be written: {}", std::strerror(errno)));
+}
+
+void check_distinct(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs) {
+  for (std::size_t i = 0; i < outputs.size(); ++i) {
+    for (const NamedFile& input : inputs)
+      if (input.file != "-" && same_file(outputs[i].file, input.file))
+        throw InputError(fmt::format("{} {}: is the {} file; expected a file that is not read", outputs[i].flag,
+                                     outputs[i].file.string(), input.flag));
+    for (std::size_t j = 0; j < i; ++j)
+      if (same_file(outputs[i].file, outputs[j].file))
+        throw InputError(fmt::format("{} {}: is also the {} file; expected a file of its own", outputs[i].flag,
+                                     outputs[i].file.string(), outputs[j].flag));
+  }
 }
 
 }  // namespace varia::host

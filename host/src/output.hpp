@@ -1,22 +1,29 @@
-// Output files (spec: "Outputs"): the trajectory CSV, written in whole rows so that the rows on
-// disk stay whole when a run stops early, and JSON documents.
+// Output files (spec: "Outputs"). Every write and close is checked: a failure throws OutputError
+// naming the file. The trajectory CSV is written in whole rows, so that the file ends with a whole
+// row on every exit path (a write that fails part-way is cut back to the last whole row); JSON
+// documents and plots are written to a temporary file beside the target and renamed over it, so a
+// reader sees the old file or the new one, never a part (docs/security.md, "Outputs").
 #pragma once
 
+#include <sys/types.h>
+
 #include <Eigen/Core>
-#include <cstdio>
 #include <filesystem>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace varia::host {
 
 class CsvWriter {
  public:
-  // "-" writes to stdout. Throws InputError when the file cannot be opened.
+  // "-" writes to stdout. A regular file is locked for the run: a second run writing the same
+  // file is refused (OutputError) before it truncates it. Throws OutputError when the file
+  // cannot be opened.
   explicit CsvWriter(const std::filesystem::path& file);
-  ~CsvWriter();
+  ~CsvWriter();  // writes what is buffered, ignoring errors: call close() to have them reported
   CsvWriter(const CsvWriter&) = delete;
   CsvWriter& operator=(const CsvWriter&) = delete;
 
@@ -24,18 +31,43 @@ class CsvWriter {
   // One row of numbers at full precision (the shortest text that reads back to the same double);
   // it reaches the file whole.
   void row(double t, const double* a, int na, const double* b, int nb, const std::vector<double>& rest);
+  // Writes the buffered rows. Throws OutputError when they cannot all be written; the file then
+  // ends with the last whole row written before.
   void flush();
+  // flush(), then closes the file, checked.
+  void close();
 
  private:
   void end_row();
-  std::FILE* file_ = nullptr;
-  bool owned_ = false;
+  std::string name_;
+  int fd_ = -1;
+  bool owned_ = false, regular_ = false, failed_ = false;
+  off_t whole_ = 0;  // bytes written that end with a whole row
   fmt::memory_buffer buffer_;
 };
 
 inline std::vector<double> as_vector(const Eigen::VectorXd& x) { return {x.data(), x.data() + x.size()}; }
 
-// Writes a JSON document (pretty-printed) to a file, or to stdout for "-".
-void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_json& document);
+// Writes `text` to `file` ("-": stdout): a regular file (or a new one) through a temporary file
+// renamed over it, anything else (a device, a pipe) directly. `what` names the output in messages
+// (e.g. "--summary"). Throws OutputError.
+void write_output(const std::filesystem::path& file, std::string_view text, std::string_view what);
+
+// Writes a JSON document (pretty-printed) through write_output.
+void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_json& document,
+                     std::string_view what = "output");
+
+// Flushes and checks stdout: results written there that did not arrive are an OutputError.
+void check_stdout();
+
+// A file a command reads or writes, as named on its command line ("-": stdin or stdout).
+struct NamedFile {
+  std::string flag;  // e.g. "--out", or "SCENE" for an input
+  std::filesystem::path file;
+};
+
+// Refuses (InputError) an output that is one of the inputs or another output: the same path, the
+// same file under another name, or stdout twice. Devices (/dev/null) may be named more than once.
+void check_distinct(const std::vector<NamedFile>& inputs, const std::vector<NamedFile>& outputs);
 
 }  // namespace varia::host

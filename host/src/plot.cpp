@@ -1,22 +1,43 @@
 #include "plot.hpp"
 
+#include <fcntl.h>
+#include <spawn.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
 #include <fmt/format.h>
 
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
+#include <cstring>
+#include <memory>
 #include <stdexcept>
+
+#include "errors.hpp"
+#include "output.hpp"
+
+extern char** environ;
 
 namespace varia::host {
 
 namespace {
 
-std::string quoted(const std::string& text) {
-  std::string out = "\"";
-  for (char c : text) {
-    if (c == '"' || c == '\\') out += '\\';
-    out += c;
+// Text shown in a plot (titles, labels, legends: they may come from scene names and file names)
+// reduced to a safe alphabet and single-quoted: gnuplot expands backquotes and macros in double
+// quotes and ends a command at a newline, but in single quotes only the quote itself is special,
+// and that is not in the alphabet. Anything else becomes '_'; "noenhanced" (by the caller) keeps
+// '_' and '^' from being read as sub- and superscripts (docs/security.md, "No code from data").
+std::string label(const std::string& text) {
+  constexpr std::size_t kMaxLength = 80;
+  std::string out = "'";
+  for (std::size_t i = 0; i < text.size() && i < kMaxLength; ++i) {
+    const char c = text[i];
+    const bool safe = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
+                      std::strchr(" .,:;()+-=*/^_[]", c) != nullptr;
+    out += safe && c != '\0' ? c : '_';
   }
-  return out + "\"";
+  return out + "'";
 }
 
 // One inline data block per series ($d<panel>_<series>), so no temporary files are needed.
@@ -38,18 +59,68 @@ std::string data_blocks(const std::vector<Panel>& panels) {
 }
 
 std::string panel_commands(const Panel& panel, std::size_t index) {
-  std::string script = fmt::format("set title {}\nset xlabel {}\nset ylabel {}\n",
-                                   quoted(panel.title), quoted(panel.xlabel), quoted(panel.ylabel));
+  std::string script = fmt::format("set title {} noenhanced\nset xlabel {} noenhanced\nset ylabel {} noenhanced\n",
+                                   label(panel.title), label(panel.xlabel), label(panel.ylabel));
   script += panel.logx ? "set logscale x\nset format x \"10^{%L}\"\n" : "unset logscale x\nset format x \"% h\"\n";
   script += panel.logy ? "set logscale y\nset format y \"10^{%L}\"\n" : "unset logscale y\nset format y \"% h\"\n";
   script += "plot ";
   for (std::size_t s = 0; s < panel.series.size(); ++s) {
     const Series& series = panel.series[s];
-    script += fmt::format("{}$d{}_{} using 1:2 with {} title {}", s ? ", " : "", index, s,
+    script += fmt::format("{}$d{}_{} using 1:2 with {} title {} noenhanced", s ? ", " : "", index, s,
                           series.dashed ? "lines dashtype 2 lw 1.5" : "linespoints pt 7 ps 0.5 lw 1.5",
-                          quoted(series.title));
+                          label(series.title));
   }
   return script + "\n";
+}
+
+// An anonymous temporary file, closed on destruction.
+struct TempFile {
+  std::FILE* file = std::tmpfile();
+  ~TempFile() {
+    if (file != nullptr) std::fclose(file);
+  }
+  int fd() const { return ::fileno(file); }
+  std::string text() const {
+    std::string all;
+    std::rewind(file);
+    char chunk[1 << 16];
+    for (std::size_t n; (n = std::fread(chunk, 1, sizeof chunk, file)) > 0;) all.append(chunk, n);
+    return all;
+  }
+};
+
+// Runs gnuplot (no shell, no init files: -d) on `script`; returns what it wrote to stdout (the
+// SVG). Its diagnostics are kept apart: they reach the message when it fails, never stdout.
+std::string run_gnuplot(const std::string& script) {
+  TempFile input, output, diagnostics;
+  if (input.file == nullptr || output.file == nullptr || diagnostics.file == nullptr ||
+      std::fwrite(script.data(), 1, script.size(), input.file) != script.size() || std::fflush(input.file) != 0 ||
+      ::lseek(input.fd(), 0, SEEK_SET) != 0)
+    throw OutputError(fmt::format("the plot's temporary files cannot be written: {}", std::strerror(errno)));
+  posix_spawn_file_actions_t actions;
+  posix_spawn_file_actions_init(&actions);
+  posix_spawn_file_actions_adddup2(&actions, input.fd(), STDIN_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, output.fd(), STDOUT_FILENO);
+  posix_spawn_file_actions_adddup2(&actions, diagnostics.fd(), STDERR_FILENO);
+  char name[] = "gnuplot", defaults[] = "-d";
+  char* argv[] = {name, defaults, nullptr};
+  pid_t pid = 0;
+  const int spawned = posix_spawnp(&pid, name, &actions, nullptr, argv, environ);
+  posix_spawn_file_actions_destroy(&actions);
+  if (spawned != 0)
+    throw OutputError(fmt::format("the plot: cannot start gnuplot: {} (is the gnuplot-nox package installed?)",
+                                         std::strerror(spawned)));
+  int status = 0;
+  while (::waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  std::string svg = output.text();
+  if (!WIFEXITED(status) || WEXITSTATUS(status) != 0 || svg.empty()) {
+    std::string why = diagnostics.text();
+    for (char& c : why)
+      if (c == '\n' || c == '\r') c = ' ';
+    throw OutputError(fmt::format("the plot: gnuplot failed: {}", why.substr(0, 300)));
+  }
+  return svg;
 }
 
 }  // namespace
@@ -58,16 +129,11 @@ void write_svg(const std::filesystem::path& file, const std::vector<Panel>& pane
   std::string script = data_blocks(panels);
   script += fmt::format(
       "set terminal svg size {},{} dynamic enhanced font 'sans,11' background rgb 'white'\n"
-      "set output {}\nset grid\nset key top right box opaque\nset multiplot layout 1,{}\n",
-      520 * panels.size(), 420, quoted(file.string()), panels.size());
+      "set grid\nset key top right box opaque\nset multiplot layout 1,{}\n",
+      520 * panels.size(), 420, panels.size());
   for (std::size_t p = 0; p < panels.size(); ++p) script += panel_commands(panels[p], p);
-  script += "unset multiplot\nset output\n";
-  FILE* gnuplot = popen("gnuplot 2>&1", "w");
-  if (gnuplot == nullptr) throw std::runtime_error("cannot start gnuplot");
-  std::fwrite(script.data(), 1, script.size(), gnuplot);
-  if (pclose(gnuplot) != 0)
-    throw std::runtime_error("gnuplot failed to write " + file.string() +
-                             " (is the gnuplot-nox package installed?)");
+  script += "unset multiplot\n";
+  write_output(file, run_gnuplot(script), "the plot");
 }
 
 }  // namespace varia::host

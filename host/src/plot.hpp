@@ -20,7 +20,8 @@ struct Panel {
   std::vector<Series> series;
 };
 
-// Writes `file` (SVG); throws std::runtime_error when gnuplot is missing or fails.
+// Writes `file` (SVG; "-": stdout) through write_output; throws OutputError when gnuplot is missing
+// or fails. No text of a panel reaches gnuplot's command language unfiltered (docs/security.md).
 void write_svg(const std::filesystem::path& file, const std::vector<Panel>& panels);
 
 }  // namespace varia::host

@@ -1,11 +1,17 @@
 #include "registry.hpp"
 
 #include <dlfcn.h>
+#include <elf.h>
 #include <sys/stat.h>
+#include <unistd.h>
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
 #include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <fstream>
+#include <optional>
 #include <cerrno>
 #include <cstring>
 #include <cstdlib>
@@ -17,6 +23,9 @@
 #include <boost/dll/library_info.hpp>
 #include <boost/dll/runtime_symbol_info.hpp>
 #include <boost/dll/shared_library.hpp>
+
+#include "crash.hpp"
+#include "json_schema.hpp"
 
 namespace fs = std::filesystem;
 
@@ -67,15 +76,37 @@ std::vector<fs::path> so_files(const fs::path& directory) {
   return files;
 }
 
-// Why a file or directory may not be trusted to hold plugins, or "" when it may: whoever can
-// write it could make the host run their code.
-std::string distrust(const fs::path& path) {
+// Why a path may not be trusted, or "" when it may: it must be owned by root or by the user running
+// varia, and writable by no one else (a directory writable by all is allowed only with the sticky
+// bit and owned by root, as /tmp: no one else can then replace what it holds).
+std::string distrust_one(const fs::path& path, bool directory) {
   struct stat status {};
   if (::stat(path.c_str(), &status) != 0) return fmt::format("cannot be inspected: {}", std::strerror(errno));
-  if ((status.st_mode & (S_IWGRP | S_IWOTH)) == 0) return "";
+  if (status.st_uid != 0 && status.st_uid != ::geteuid())
+    return fmt::format("owned by another user (uid {}); plugins are loaded only from files and directories owned "
+                       "by root or by the user running varia",
+                       status.st_uid);
+  const bool shared_sticky = directory && (status.st_mode & S_ISVTX) != 0 && status.st_uid == 0;
+  if ((status.st_mode & (S_IWGRP | S_IWOTH)) == 0 || shared_sticky) return "";
   return fmt::format("writable by group or others (mode {:04o}); plugins are loaded only from files and "
                      "directories that only their owner can write",
                      status.st_mode & 07777);
+}
+
+// Why a plugin file may not be trusted, or "" when it may (as sshd's StrictModes and sudo check):
+// whoever can write the file, or any directory above it, could make the host run their code. The
+// file is followed through symbolic links to the file itself.
+std::string distrust(const fs::path& file) {
+  std::error_code ec;
+  const fs::path real = fs::canonical(file, ec);
+  if (ec) return fmt::format("cannot be inspected: {}", ec.message());
+  if (std::string why = distrust_one(real, false); !why.empty())
+    return real == file ? why : fmt::format("{} (where it links to) is {}", real.string(), why);
+  for (fs::path directory = real.parent_path();; directory = directory.parent_path()) {
+    if (std::string why = distrust_one(directory, true); !why.empty())
+      return fmt::format("its directory {} is {}", directory.string(), why);
+    if (directory == directory.parent_path()) return "";
+  }
 }
 
 std::string dlopen_error(const fs::path& file) {
@@ -94,6 +125,19 @@ nlohmann::json parse_metadata(const char* text, const char* what) {
   } catch (const nlohmann::json::exception& e) {
     throw Refused{fmt::format("malformed {} in varia_info: {}", what, e.what())};
   }
+}
+
+// The parameter schema, refused when the host would not give it to valijson or valijson cannot
+// read it: a bad schema refuses its plugin only (docs/security.md, "Plugins").
+nlohmann::json parameter_schema(const char* text) {
+  nlohmann::json schema = parse_metadata(text, "parameter_schema");
+  try {
+    check_parameter_schema(schema);
+    SchemaValidator{schema};
+  } catch (const std::invalid_argument& e) {
+    throw Refused{fmt::format("unusable parameter_schema in varia_info: {}", e.what())};
+  }
+  return schema;
 }
 
 // Deletes a plugin's object, then releases the object's hold on the library that made it.
@@ -139,7 +183,7 @@ PluginRecord read_info(const boost::dll::shared_library& library, const fs::path
       info->version == nullptr || info->parameter_schema == nullptr || info->properties == nullptr)
     throw Refused{"missing metadata (varia_info has an empty field)"};
   return PluginRecord{file, info->kind, info->type, info->version,
-                      parse_metadata(info->parameter_schema, "parameter_schema"),
+                      parameter_schema(info->parameter_schema),
                       parse_metadata(info->properties, "properties")};
 }
 
@@ -149,6 +193,7 @@ std::shared_ptr<Registry::Loaded> Registry::load(const fs::path& file, const Sym
   try {
     if (!scan.parsed) throw Refused{"not a shared library (its format cannot be read)"};
     auto loaded = std::make_shared<Loaded>();
+    note_plugin_file(file);  // before its code runs: a crash in its initializers is named too
     loaded->library = open_library(file);
     check_abi(*loaded->library);
     loaded->record = read_info(*loaded->library, file);
@@ -196,14 +241,11 @@ const std::vector<fs::path>& Registry::candidates() {
   std::set<fs::path> seen;  // a directory named twice must not make its plugins duplicates
   for (const auto& directory : directories_) {
     const auto files = so_files(directory);
-    const std::string directory_distrust = files.empty() ? "" : distrust(directory);
     for (const auto& file : files) {
       std::error_code ec;
       const auto canonical = fs::weakly_canonical(file, ec);
       if (!seen.insert(ec ? file : canonical).second) continue;
-      const std::string reason = directory_distrust.empty()
-                                     ? distrust(file)
-                                     : fmt::format("its directory {} is {}", directory.string(), directory_distrust);
+      const std::string reason = distrust(file);
       if (reason.empty())
         candidates_->push_back(file);
       else
@@ -213,17 +255,67 @@ const std::vector<fs::path>& Registry::candidates() {
   return *candidates_;
 }
 
+namespace {
+
+// The names in the dynamic symbol table (.dynsym) of an ELF64 file of this machine's byte order:
+// what the dynamic loader reads, so `strip` keeps it (boost::dll::library_info reads .symtab only).
+// None when the file is not such a file.
+std::optional<std::vector<std::string>> dynamic_symbols(const fs::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  Elf64_Ehdr header{};
+  constexpr unsigned char kByteOrder = std::endian::native == std::endian::little ? ELFDATA2LSB : ELFDATA2MSB;
+  if (!in.read(reinterpret_cast<char*>(&header), sizeof header) || std::memcmp(header.e_ident, ELFMAG, SELFMAG) != 0 ||
+      header.e_ident[EI_CLASS] != ELFCLASS64 || header.e_ident[EI_DATA] != kByteOrder ||
+      header.e_shentsize != sizeof(Elf64_Shdr))
+    return std::nullopt;
+  std::vector<Elf64_Shdr> sections(header.e_shnum);
+  in.seekg(static_cast<std::streamoff>(header.e_shoff));
+  if (!in.read(reinterpret_cast<char*>(sections.data()), static_cast<std::streamsize>(sections.size() * sizeof(Elf64_Shdr))))
+    return std::nullopt;
+  const auto contents = [&](const Elf64_Shdr& section) -> std::optional<std::string> {
+    constexpr std::uint64_t kMaxBytes = 64u << 20;
+    if (section.sh_size > kMaxBytes) return std::nullopt;
+    std::string bytes(section.sh_size, '\0');
+    in.seekg(static_cast<std::streamoff>(section.sh_offset));
+    if (!in.read(bytes.data(), static_cast<std::streamsize>(bytes.size()))) return std::nullopt;
+    return bytes;
+  };
+  std::vector<std::string> names;
+  for (const auto& section : sections) {
+    if (section.sh_type != SHT_DYNSYM || section.sh_link >= sections.size() || section.sh_entsize != sizeof(Elf64_Sym))
+      continue;
+    const auto table = contents(section), strings = contents(sections[section.sh_link]);
+    if (!table || !strings) return std::nullopt;
+    for (std::size_t at = 0; at + sizeof(Elf64_Sym) <= table->size(); at += sizeof(Elf64_Sym)) {
+      Elf64_Sym symbol{};
+      std::memcpy(&symbol, table->data() + at, sizeof symbol);
+      if (symbol.st_name < strings->size())
+        names.emplace_back(strings->data() + symbol.st_name, strnlen(strings->data() + symbol.st_name,
+                                                                      strings->size() - symbol.st_name));
+    }
+  }
+  return names;
+}
+
+}  // namespace
+
 const SymbolScan& Registry::scan(const fs::path& file) {
   auto [it, inserted] = scans_.try_emplace(file);
   if (!inserted) return it->second;
   SymbolScan& result = it->second;
-  try {
-    boost::dll::library_info info(file, false);
-    const auto symbols = info.symbols();
+  const auto read = [&](const auto& symbols) {
     result.parsed = true;
     result.has_symbol_table = !symbols.empty();
     for (const auto& symbol : symbols)
       if (auto marker = parse_marker(symbol)) result.markers.push_back(std::move(*marker));
+  };
+  if (const auto names = dynamic_symbols(file)) {
+    read(*names);
+    return result;
+  }
+  try {  // not ELF64: what boost::dll can read
+    boost::dll::library_info info(file, false);
+    read(info.symbols());
   } catch (const std::exception&) {
     result.parsed = false;  // reported by list(); find() skips it
   }

@@ -39,10 +39,11 @@ struct Marker {
   std::string kind, type;
 };
 
-// What the symbol table of a candidate says, read without loading it.
+// What the symbol table of a candidate says, read without loading it: the dynamic symbol table of
+// an ELF64 file (kept by `strip`), else what boost::dll reads.
 struct SymbolScan {
-  bool parsed = false;            // false: not a binary boost::dll can read
-  bool has_symbol_table = false;  // false: stripped; find() must load it to learn its type
+  bool parsed = false;            // false: not a binary that can be read
+  bool has_symbol_table = false;  // false: no symbols at all; find() must load it to learn its type
   std::vector<Marker> markers;
 };
 

@@ -9,6 +9,7 @@
 #include <cstdio>
 #include <memory>
 
+#include "interrupt.hpp"
 #include "observer.hpp"
 #include "output.hpp"
 #include "plot.hpp"
@@ -158,14 +159,16 @@ class Stepper {
       trajectory_.run_to(scene_.steps, [&](const Trajectory& x) {
         observe_and_write();
         progress.update(x.steps());
+        return interruption() == 0;
       });
     } catch (const StepFailure& e) {
-      failure = Failure{e.step(), e.t(), e.residual(), e.what()};
+      failure = Failure{e.step(), e.t(), e.residual(), e.what(), e.origin()};
     } catch (const NumericalFailure& e) {  // an observable that could not be formed
       failure = observable_failure(e.what(), e.residual());
+      failure->origin = e.origin();
     }
     outcome_.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
-    if (csv_) csv_->flush();
+    if (csv_) csv_->close();
     return failure;
   }
 
@@ -225,19 +228,39 @@ json residual_json(double residual) {
 
 void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options) {
   Stepper stepper(scene, assembly, options);
-  const auto failure = stepper.run(options.quiet);
-  json record = run_record(scene, assembly, stepper.observer(), stepper.state(), stepper.outcome(), registry);
+  // A plugin fault or an interruption also leaves a run record, noting it (docs/security.md).
+  const auto write_record = [&](const json& note) {
+    json record = run_record(scene, assembly, stepper.observer(), stepper.state(), stepper.outcome(), registry);
+    for (const auto& [key, value] : note.items()) record[key] = value;
+    if (options.summary) write_json_file(*options.summary, record, "--summary");
+  };
+  std::optional<Failure> failure;
+  try {
+    failure = stepper.run(options.quiet);
+  } catch (const PluginFault& e) {
+    write_record({{"failure",
+                   {{"step", stepper.state().steps() + 1}, {"t", stepper.state().t()}, {"plugin_fault", e.what()}}}});
+    throw;
+  }
+  if (const int signal = interruption(); signal != 0 && !failure) {
+    write_record({{"interrupted", {{"signal", signal_name(signal)}, {"steps_completed", stepper.state().steps()}}}});
+    throw Interrupted(signal, fmt::format("after step {} of {} (t = {:.10g}); the trajectory ends with that step's "
+                                          "row and the run record notes the interruption",
+                                          stepper.state().steps(), scene.steps, stepper.state().t()));
+  }
   if (failure)
-    record["failure"] = {{"step", failure->step},
-                         {"t", failure->t},
-                         {"residual", residual_json(failure->residual)},
-                         {"message", failure->message}};
-  if (options.summary) write_json_file(*options.summary, record);
+    write_record({{"failure",
+                   {{"step", failure->step},
+                    {"t", failure->t},
+                    {"residual", residual_json(failure->residual)},
+                    {"message", failure->message}}}});
+  else
+    write_record(json::object());
   if (options.plot) stepper.plot()->write(*options.plot);
   if (failure)
     throw NumericalFailure(fmt::format("step {} (from t = {:.10g}) failed: {}; residual {:.3e}", failure->step,
                                        failure->t, failure->message, failure->residual),
-                           failure->residual);
+                           failure->residual, failure->origin);
   // With the trajectory on stdout, the human summary goes to stderr.
   if (!options.quiet) print_human_summary(options.out && *options.out == "-" ? stderr : stdout, scene, assembly,
                                           stepper.observer(), stepper.state(), stepper.outcome());

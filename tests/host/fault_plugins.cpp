@@ -5,6 +5,8 @@
 // Plugins in files or directories that group or others can write are refused ("Trust").
 #include <doctest/doctest.h>
 
+#include <unistd.h>
+
 #include <nlohmann/json.hpp>
 
 #include "host/support.hpp"
@@ -51,6 +53,7 @@ TEST_CASE("plugins lists the good fault plugins and refuses each bad file with i
       {"fault_wrong_abi.so", "ABI version " + std::to_string(kAbiVersion + 100) + ", this host speaks " +
                                  std::to_string(kAbiVersion)},
       {"fault_no_metadata.so", "missing metadata (no varia_info)"},
+      {"fault_bad_schema.so", "unusable parameter_schema in varia_info: "},
   };
   const auto table = run_varia("plugins " + faults.flag());
   CAPTURE(table.out);
@@ -79,6 +82,7 @@ TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) namin
       {"fault-nan", 4, "fault_returns_nan.so", "is not finite"},
       {"fault-abi", 3, "fault_wrong_abi.so", "ABI version"},
       {"fault-no-info", 3, "fault_no_metadata.so", "missing metadata (no varia_info)"},
+      {"fault-bad-schema", 3, "fault_bad_schema.so", "unusable parameter_schema"},
   };
   for (const auto& c : cases) {
     CAPTURE(c.lagrangian);
@@ -93,6 +97,20 @@ TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) namin
     check_one_error_line(outcome, (faults.dir / c.file).string());
     CHECK(contains(outcome.err, c.reason));
   }
+}
+
+TEST_CASE("a plugin fault in the middle of a run leaves a run record that notes it") {
+  const FaultDirectory faults;
+  const auto scene = scene_with_lagrangian(faults.dir, "fault-evaluate");
+  const auto record_file = faults.dir / "r.json";
+  const auto outcome = run_varia("run '" + scene.string() + "' --quiet --summary '" + record_file.string() + "' " +
+                                 faults.flag());
+  CHECK(outcome.code == 3);
+  REQUIRE(fs::exists(record_file));
+  const json record = json::parse(read_file(record_file));
+  REQUIRE(record.contains("failure"));
+  CHECK(contains(record["failure"]["plugin_fault"].get<std::string>(), "deliberate failure in evaluate"));
+  CHECK(record["failure"]["step"] == 1);
 }
 
 struct TrustCase {
@@ -129,6 +147,77 @@ TEST_CASE("plugins in files or directories writable by group or others are refus
                                                     "not trusted: ");
     CHECK(run_varia("run scenes/default.json --quiet" + flag).code == 0);
   }
+}
+
+// As sshd's StrictModes: the file a link leads to, every directory above it, and the owners.
+TEST_CASE("plugins behind a link, under a writable parent or owned by another user are refused") {
+  struct Layout {
+    const char* name;
+    const char* reason;
+    bool needs_root;  // to give a file to another user
+    void (*make)(const TempDir& top, const fs::path& plugin_dir);
+  };
+  const Layout layouts[] = {
+      {"a link to a file in a directory writable by all", "/open is writable by group or others", false,
+       [](const TempDir& top, const fs::path& plugin_dir) {
+         fs::create_directory(top / "open");
+         fs::copy_file(kFaultPluginDir / "fault_returns_nan.so", top / "open" / "real.so");
+         fs::permissions(top / "open", fs::perms::all);
+         fs::create_symlink(top / "open" / "real.so", plugin_dir / "fault_returns_nan.so");
+       }},
+      {"an owner-only directory under a parent writable by all", "writable by group or others", false,
+       [](const TempDir& top, const fs::path& plugin_dir) {
+         fs::copy_file(kFaultPluginDir / "fault_returns_nan.so", plugin_dir / "fault_returns_nan.so");
+         fs::permissions(top.path(), fs::perms::all);
+       }},
+      {"a file owned by another user", "owned by another user", true,
+       [](const TempDir&, const fs::path& plugin_dir) {
+         fs::copy_file(kFaultPluginDir / "fault_returns_nan.so", plugin_dir / "fault_returns_nan.so");
+         REQUIRE(::chown((plugin_dir / "fault_returns_nan.so").c_str(), 65534, -1) == 0);
+       }},
+  };
+  for (const auto& layout : layouts) {
+    CAPTURE(layout.name);
+    if (layout.needs_root && ::geteuid() != 0) continue;
+    TempDir top;
+    const fs::path plugin_dir = top / "plugins";
+    fs::create_directory(plugin_dir);
+    fs::permissions(plugin_dir, fs::perms::owner_all);
+    layout.make(top, plugin_dir);
+    const auto listing = run_varia("plugins --plugin-path '" + plugin_dir.string() + "'");
+    fs::permissions(top.path(), fs::perms::owner_all);
+    CHECK(listing.code == 0);
+    CHECK(contains(listing.out, (plugin_dir / "fault_returns_nan.so").string() + ": not trusted: "));
+    CHECK(contains(listing.out, layout.reason));
+    CHECK_FALSE(contains(listing.out, "fault-nan"));
+  }
+}
+
+TEST_CASE("a plugin whose type no scene names is never loaded, stripped or not") {
+  for (const bool stripped : {false, true}) {
+    CAPTURE(stripped);
+    TempDir dir;
+    const auto plugin = dir / "fault_aborts_on_load.so";
+    fs::copy_file(fs::path(VARIA_ABORTING_PLUGIN_DIR) / "fault_aborts_on_load.so", plugin);
+    if (stripped) REQUIRE(std::system(("strip --strip-all '" + plugin.string() + "'").c_str()) == 0);
+    const auto outcome = run_varia("run scenes/default.json --quiet --plugin-path '" + dir.path().string() + "'");
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == 0);
+  }
+}
+
+TEST_CASE("a plugin that crashes varia is named on stderr") {
+  TempDir dir;
+  fs::copy_file(fs::path(VARIA_ABORTING_PLUGIN_DIR) / "fault_aborts_on_load.so", dir / "fault_aborts_on_load.so");
+  const auto outcome = run_varia("plugins --plugin-path '" + dir.path().string() + "'");
+  CHECK(outcome.code != 0);
+  // One line from varia (the shell that ran it may add its own "Aborted" after it).
+  const auto lines = lines_of(outcome.err);
+  CAPTURE(outcome.err);
+  REQUIRE(!lines.empty());
+  CHECK(std::count_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("varia:", 0) == 0; }) == 1);
+  CHECK(contains(lines[0], "varia: error: plugin fault: fatal signal SIGABRT (abort) in a call to the plugin "));
+  CHECK(contains(lines[0], "fault_aborts_on_load.so"));
 }
 
 }  // namespace

@@ -47,7 +47,7 @@ TEST_CASE("each schema violation is one line naming its JSON pointer and what wa
       {"/method/construction", "galerkn", "/method/construction: expected one of \"galerkin\""},
       {"/method/form", "hamiltonian", "/method/form: unknown key 'form'; the keys allowed here are: construction, "},
       {"/output", json{{"every", 0}}, "/output/every: expected an integer >= 1"},
-      {"/observe", json{"energy", "energy"}, "/observe: expected an array"},
+      {"/observe", json{"energy", "energy"}, "/observe/1: a repeated item (\"energy\"); expected items that are all"},
       {"/initial/q", json{"a"}, "/initial/q/0: expected a number"},
       {"/system/manifold", json{{"dim", 1}}, "/system/manifold/type: missing"},
       {"/system/manifold/type", 3, "/system/manifold/type: expected a string"},

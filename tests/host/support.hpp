@@ -23,6 +23,13 @@ inline const fs::path kBuildDir = VARIA_BUILD_DIR;
 inline const fs::path kSourceDir = VARIA_SOURCE_DIR;
 inline const fs::path kPluginDir = kBuildDir / "lib" / "varia" / "plugins";
 
+// The program under test: build/bin/varia, or VARIA_TEST_PROGRAM (to run the tests against another
+// build, e.g. one from before a fix, to see them fail).
+inline fs::path varia_program() {
+  const char* other = std::getenv("VARIA_TEST_PROGRAM");
+  return other != nullptr && *other != '\0' ? fs::path(other) : kBuildDir / "bin" / "varia";
+}
+
 // A directory of its own for one test, removed with everything in it at the end.
 class TempDir {
  public:
@@ -76,7 +83,7 @@ struct Outcome {
 inline Outcome run_varia(const std::string& arguments) {
   TempDir dir;
   const auto out = dir / "stdout", err = dir / "stderr";
-  const std::string command = "cd '" + kSourceDir.string() + "' && '" + (kBuildDir / "bin" / "varia").string() +
+  const std::string command = "cd '" + kSourceDir.string() + "' && '" + varia_program().string() +
                               "' " + arguments + " > '" + out.string() + "' 2> '" + err.string() + "'";
   const int status = std::system(command.c_str());
   Outcome outcome;

@@ -44,12 +44,13 @@ class Trajectory {
   // the benchmarks time, free to keep its state in registers). On failure (StepFailure naming the
   // last step of the stretch) the state is unspecified.
   void advance(long count);
-  // Steps to `last` (a total count of steps), calling observe(*this) after every step.
+  // Steps to `last` (a total count of steps), calling observe(*this) after every step; stops
+  // early when observe returns false (an interrupted run).
   template <class Observe>
   void run_to(long last, Observe&& observe) {
     while (steps_ < last) {
       step();
-      observe(*this);
+      if (!observe(*this)) return;
     }
   }
 

@@ -1,0 +1,43 @@
+#include "interrupt.hpp"
+
+#include <fmt/format.h>
+
+#include <csignal>
+
+namespace varia::host {
+
+namespace {
+
+volatile std::sig_atomic_t requested = 0;
+
+void on_signal(int signal) {
+  if (requested != 0) {  // the second one: the default action, now
+    std::signal(signal, SIG_DFL);
+    std::raise(signal);
+    return;
+  }
+  requested = signal;
+}
+
+}  // namespace
+
+void install_interrupt_handlers() {
+  struct sigaction action {};
+  action.sa_handler = on_signal;
+  action.sa_flags = SA_RESTART;  // a write in progress is finished, not cut
+  sigemptyset(&action.sa_mask);
+  for (int signal : {SIGINT, SIGTERM}) sigaction(signal, &action, nullptr);
+}
+
+int interruption() { return requested; }
+
+std::string signal_name(int signal) { return signal == SIGINT ? "SIGINT" : signal == SIGTERM ? "SIGTERM" : fmt::format("signal {}", signal); }
+
+Interrupted::Interrupted(int signal, const std::string& where)
+    : std::runtime_error(fmt::format("interrupted by {} {}", signal_name(signal), where)), signal_(signal) {}
+
+void stop_if_interrupted(const std::string& where) {
+  if (const int signal = interruption(); signal != 0) throw Interrupted(signal, where);
+}
+
+}  // namespace varia::host
