@@ -26,13 +26,13 @@ void Forces::evaluate(double t, const double* q, const double* v, double* force,
   const int n = static_cast<int>(one_.size());
   std::fill(force, force + n, 0.0);
   for (std::size_t k = 0; k < forces_.size(); ++k) {
-    check(forces_[k]->evaluate(t, q, v, one_.data(), jacobian ? jacobian + offsets_[k] : nullptr),
+    check(*forces_[k], forces_[k]->evaluate(t, q, v, one_.data(), jacobian ? jacobian + offsets_[k] : nullptr),
           "force evaluation");
+    for (int i = 0; i < n; ++i)
+      if (!std::isfinite(one_[i])) throw NumericalFailure("a force is not finite", std::nan(""), forces_[k]->origin());
     for (int i = 0; i < n; ++i) force[i] += one_[i];
   }
   ++evaluations_;
-  for (int i = 0; i < n; ++i)
-    if (!std::isfinite(force[i])) throw NumericalFailure("a force is not finite", std::nan(""));
 }
 
 }  // namespace varia

@@ -75,7 +75,7 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
 }
 
 void LieGroupGalerkinDiscreteLagrangian::check(Status status) const {
-  varia::check(status, "manifold chart_jets");
+  varia::check(manifold_, status, "manifold chart_jets");
 }
 
 // One quadrature node of the action: z = (g, Omega) of the chart curve as jets in the node's

@@ -154,12 +154,12 @@ void EulerLagrangeField::advance(OneStepMethod& method, double h, const T* y0, T
   if (Status status = method.step(*this, h, y0, y1, &report)) {
     if (pending_) std::rethrow_exception(pending_);
     if (!report.converged) throw NumericalFailure(status, report.residual);
-    throw PluginFault(std::string("one-step method: ") + status);
+    throw PluginFault(std::string("one-step method: ") + status, method.origin());
   }
   stages.record(report.iterations);
   for (int r = 0; r < size(); ++r)
     if (!std::isfinite(value_of(y1[r])))
-      throw NumericalFailure("the one-step method produced a non-finite state", std::nan(""));
+      throw NumericalFailure("the one-step method produced a non-finite state", std::nan(""), method.origin());
 }
 
 void EulerLagrangeField::step(OneStepMethod& method, double h, const double* y0, double* y1,

@@ -25,12 +25,13 @@ LagrangianEvaluator::LagrangianEvaluator(Lagrangian& lagrangian)
 // Out of line, so that the inline check that runs on every evaluation is a loop of scalar loads
 // and well-predicted branches.
 void LagrangianEvaluator::not_finite(const char* what) {
-  throw NumericalFailure(std::string("the Lagrangian's ") + what + " is not finite", std::nan(""));
+  throw NumericalFailure(std::string("the Lagrangian's ") + what + " is not finite", std::nan(""),
+                         lagrangian_.origin());
 }
 
 double LagrangianEvaluator::value(const double* q, const double* v) {
   double L = 0.0;
-  check(lagrangian_.evaluate(q, v, &L, nullptr, nullptr), "Lagrangian evaluation");
+  check(lagrangian_, lagrangian_.evaluate(q, v, &L, nullptr, nullptr), "Lagrangian evaluation");
   ++counters_.lagrangian;
   check_finite(&L, 1, "value");
   return L;
@@ -53,7 +54,7 @@ double LagrangianEvaluator::hessian(const double* q, const double* v, double* gr
     return L;
   }
   double L = 0.0;
-  check(lagrangian_.evaluate(q, v, &L, gradient, hessian), "Lagrangian Hessian");
+  check(lagrangian_, lagrangian_.evaluate(q, v, &L, gradient, hessian), "Lagrangian Hessian");
   ++counters_.hessian;
   check_finite(gradient, k, "gradient");
   check_finite(hessian, k * k, "Hessian");
@@ -63,7 +64,7 @@ double LagrangianEvaluator::hessian(const double* q, const double* v, double* gr
 double LagrangianEvaluator::sparse_hessian(const double* q, const double* v, double* gradient,
                                            double* values) {
   double L = 0.0;
-  check(lagrangian_.evaluate(q, v, &L, gradient, values), "Lagrangian Hessian");
+  check(lagrangian_, lagrangian_.evaluate(q, v, &L, gradient, values), "Lagrangian Hessian");
   ++counters_.hessian;
   check_finite(gradient, m_ + n_, "gradient");
   check_finite(values, pattern_size_, "Hessian");
@@ -71,11 +72,12 @@ double LagrangianEvaluator::sparse_hessian(const double* q, const double* v, dou
 }
 
 void LagrangianEvaluator::gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) {
-  check(lagrangian_.gradient_jet(q, v, value, gradient), "Lagrangian gradient at jets");
+  check(lagrangian_, lagrangian_.gradient_jet(q, v, value, gradient), "Lagrangian gradient at jets");
   ++counters_.hessian;
   bool finite = value == nullptr || isfinite(*value);
   for (int i = 0; i < m_ + n_; ++i) finite = finite && isfinite(gradient[i]);
-  if (!finite) throw NumericalFailure("the Lagrangian's gradient at jets is not finite", std::nan(""));
+  if (!finite)
+    throw NumericalFailure("the Lagrangian's gradient at jets is not finite", std::nan(""), lagrangian_.origin());
 }
 
 void LagrangianEvaluator::legendre(const double* q, const double* v, double* p) {

@@ -19,6 +19,10 @@ Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingFo
   else if (form != ShootingForm::lagrangian)
     throw std::invalid_argument("the shooting construction on a Lie group takes the lagrangian form "
                                 "(the Euler-Lagrange field on TQ) only");
+  if (!lagrangian.evaluates_at_jets())
+    throw std::invalid_argument("the shooting construction propagates jets through the Euler-Lagrange field, and "
+                                "this Lagrangian does not evaluate at jets (models derived from "
+                                "sdk::AutodiffLagrangian do; the composite Lagrangian does not)");
   if (2 * manifold.dim() > kMaxJetVariables)
     throw std::invalid_argument("the shooting construction differentiates the propagation with "
                                 "jets of at most " + std::to_string(kMaxJetVariables) +
@@ -163,7 +167,7 @@ void ShootingDiscreteLagrangian::start_point(const double* q0) {
     for (int r = 0; r < n_; ++r) state_[r] = Jet2::variable(q0[r], 2 * n_, r);
     return;
   }
-  check(manifold_.chart_jets(q0, zero_.data(), zero_.data(), state_.data(), nullptr), "manifold chart at jets");
+  check(manifold_, manifold_.chart_jets(q0, zero_.data(), zero_.data(), state_.data(), nullptr), "manifold chart at jets");
   for (int r = 0; r < m_; ++r) {
     if (state_[r].constant()) continue;
     state_[r].gradient.tail(n_).setZero();
@@ -211,7 +215,7 @@ void ShootingDiscreteLagrangian::boundary() {
   }
   if (target_is_end_)
     for (int r = 0; r < m_; ++r) target_[r] = state_[r].value;
-  check(manifold_.local_jets(target_.data(), state_.data(), boundary_.data()), "manifold chart at jets");
+  check(manifold_, manifold_.local_jets(target_.data(), state_.data(), boundary_.data()), "manifold chart at jets");
 }
 
 // lambda = B_w^{-T} alpha_w, D1 = alpha_q - B_q^T lambda, Phi = d alpha/dx - sum_r lambda_r Hess B_r,
@@ -313,7 +317,7 @@ const EvaluationCounters& ShootingDiscreteLagrangian::evaluations() const {
 void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, double h,
                                           double* Ld, double* D1, double* D2) {
   forced_ = false;  // L_d alone: the forces are not part of it
-  check(manifold_.local(q0, q1, w_.data()), "manifold chart");
+  check(manifold_, manifold_.local(q0, q1, w_.data()), "manifold chart");
   w_ /= h;
   if (form_ != ShootingForm::lagrangian) w_ = field_->mass() * w_;
   target_is_end_ = false;

@@ -13,7 +13,7 @@ void Trajectory::step() {
   try {
     map_.step(q_.data(), p_.data(), t, h_, q1_.data(), p1_.data());
   } catch (const NumericalFailure& e) {
-    throw StepFailure(e.what(), e.residual(), steps_ + 1, t);
+    throw StepFailure(e, steps_ + 1, t);
   }
   if (!q1_.allFinite() || !p1_.allFinite()) throw StepFailure("a non-finite state", std::nan(""), steps_ + 1, t);
   q_.swap(q1_);
@@ -26,7 +26,7 @@ void Trajectory::advance(long count) {
   try {
     map_.advance(q_.data(), p_.data(), time_of(steps_), h_, count, q1_.data(), p1_.data());
   } catch (const NumericalFailure& e) {
-    throw StepFailure(e.what(), e.residual(), last, time_of(last - 1));
+    throw StepFailure(e, last, time_of(last - 1));
   }
   if (!q_.allFinite() || !p_.allFinite())
     throw StepFailure("a non-finite state", std::nan(""), last, time_of(last - 1));

@@ -68,9 +68,9 @@ std::vector<SamplePair> sample_pairs(Manifold& manifold, const double* q, const 
   for (int k = 0; k < count; ++k) {
     SamplePair pair{std::vector<double>(m), std::vector<double>(m)};
     for (int i = 0; i < n; ++i) shift[i] = 0.1 * uniform(random);
-    check(manifold.retract(q, shift.data(), pair.q0.data()), "retract");
+    check(manifold, manifold.retract(q, shift.data(), pair.q0.data()), "retract");
     for (int i = 0; i < n; ++i) shift[i] = h * (v[i] + 0.1 * uniform(random));
-    check(manifold.retract(pair.q0.data(), shift.data(), pair.q1.data()), "retract");
+    check(manifold, manifold.retract(pair.q0.data(), shift.data(), pair.q1.data()), "retract");
     pairs.push_back(std::move(pair));
   }
   return pairs;
@@ -96,8 +96,8 @@ double invariance_residual(DiscreteLagrangian& Ld, Lagrangian& lagrangian,
   std::vector<double> v(lagrangian.velocity_size(), 0.0), gv(v.size());
   for (const auto& pair : pairs) {
     std::vector<double> g0(pair.q0.size()), g1(pair.q1.size());
-    check(lagrangian.act(seed, pair.q0.data(), v.data(), g0.data(), gv.data()), "group action");
-    check(lagrangian.act(seed, pair.q1.data(), v.data(), g1.data(), gv.data()), "group action");
+    check(lagrangian, lagrangian.act(seed, pair.q0.data(), v.data(), g0.data(), gv.data()), "group action");
+    check(lagrangian, lagrangian.act(seed, pair.q1.data(), v.data(), g1.data(), gv.data()), "group action");
     ++seed;
     double original = 0.0, moved = 0.0;
     Ld.evaluate(pair.q0.data(), pair.q1.data(), h, &original, nullptr, nullptr);
@@ -114,11 +114,11 @@ void exact_discrete_lagrangian(LagrangianEvaluator& lagrangian, const double* no
   std::vector<double> q(lagrangian.position_size()), v(lagrangian.velocity_size());
   double sum = 0.0;
   for (int i = 0; i < points; ++i) {
-    check(plugin.exact_solution(q0, v0, nodes[i] * h, q.data(), v.data()), "exact solution");
+    check(plugin, plugin.exact_solution(q0, v0, nodes[i] * h, q.data(), v.data()), "exact solution");
     sum += weights[i] * lagrangian.value(q.data(), v.data());
   }
   *LdE = h * sum;
-  check(plugin.exact_solution(q0, v0, h, q1, v.data()), "exact solution");
+  check(plugin, plugin.exact_solution(q0, v0, h, q1, v.data()), "exact solution");
 }
 
 void run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::VectorXd& p, double t0, double h,
@@ -144,11 +144,11 @@ class CanonicalChart {
         n_(manifold.dim()), q_(manifold.point_size()), q1_(manifold.point_size()), mu_(n_), mu1_(n_),
         B_(n_, n_), jets_(n_) {}
   void step(const Eigen::VectorXd& z, double h, Eigen::VectorXd& out) {
-    check(manifold_.retract(base_.data(), z.data(), q_.data()), "manifold retract");
+    check(manifold_, manifold_.retract(base_.data(), z.data(), q_.data()), "manifold retract");
     chart_momentum_matrix(z.data());
     mu_ = B_.transpose().partialPivLu().solve(z.tail(n_));
     map_.step(q_.data(), mu_.data(), h, q1_.data(), mu1_.data());
-    check(manifold_.local(base_.data(), q1_.data(), out.data()), "manifold local");
+    check(manifold_, manifold_.local(base_.data(), q1_.data(), out.data()), "manifold local");
     chart_momentum_matrix(out.data());
     out.tail(n_) = B_.transpose() * mu1_;
   }
@@ -160,7 +160,7 @@ class CanonicalChart {
       return;
     }
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
-    check(manifold_.chart_jets(base_.data(), xi, zero.data(), nullptr, jets_.data()), "manifold chart_jets");
+    check(manifold_, manifold_.chart_jets(base_.data(), xi, zero.data(), nullptr, jets_.data()), "manifold chart_jets");
     for (int k = 0; k < n_; ++k) B_.row(k) = jets_[k].gradient.tail(n_).transpose();
   }
   DiscreteHamiltonianMap& map_;

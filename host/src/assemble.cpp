@@ -72,15 +72,16 @@ void initial_state(const Scene& scene, Assembly& a) {
 // in core (varia/core/composite.hpp), so that no plugin calls another; the composite plugin itself
 // carries the type's metadata and schema (docs/effects.md).
 std::shared_ptr<Lagrangian> composite(const Scene& scene, Registry& registry, const sdk::Context& context) {
-  registry.find(scene.lagrangian.kind, scene.lagrangian.type);
   std::vector<std::shared_ptr<Effect>> effects;
   for (const auto& spec : scene.effects)
-    effects.push_back(registry.create_as<Effect>(spec.kind, spec.type, spec.parameters, context));
+    effects.push_back(make_part<Effect>(registry, spec, context));
   const auto& parameters = scene.lagrangian.parameters;
   try {
-    return std::make_shared<CompositeLagrangian>(parameters.value("space_dim", 1),
-                                                 parameters.value("masses", std::vector<double>{1.0}),
-                                                 std::move(effects));
+    auto made = std::make_shared<CompositeLagrangian>(parameters.value("space_dim", 1),
+                                                      parameters.value("masses", std::vector<double>{1.0}),
+                                                      std::move(effects));
+    made->set_origin(&registry.find(scene.lagrangian.kind, scene.lagrangian.type));
+    return made;
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}/{}", scene.lagrangian.pointer, e.what()));
   }
@@ -99,8 +100,7 @@ bool has_exact_solution(const Assembly& a) { return a.forces.empty() && a.lagran
 Assembly assemble(const Scene& scene, Registry& registry) {
   Assembly a;
   // The manifold first: its sizes go into the context of the others (Rn reads its "dim").
-  a.manifold = registry.create_as<Manifold>(scene.manifold.kind, scene.manifold.type, scene.manifold.parameters,
-                                            sdk::Context{scene.manifold.type, 0, 0});
+  a.manifold = make_part<Manifold>(registry, scene.manifold, sdk::Context{scene.manifold.type, 0, 0});
   check_initial_state(scene, *a.manifold, scene.manifold.type);
   a.lagrangian = lagrangian(scene, registry, *a.manifold);
   check_lagrangian_fits(scene, *a.lagrangian, *a.manifold);

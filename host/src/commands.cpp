@@ -24,18 +24,20 @@ namespace {
 Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
 
 // Runs a command's body with a registry of its own. A plugin fault, or a non-finite value that a
-// plugin returned, is re-thrown naming the plugin (kind, type, file) it came from (spec "Exit codes").
+// plugin returned, is re-thrown naming the plugin (kind, type, file) of the object that failed: the
+// object carries its plugin record (PluginObject::origin, set by Registry::create) into the fault.
 template <class Body>
 int with_registry(const CommonOptions& common, Body&& body) {
   Registry registry = make_registry(common);
   try {
     return body(registry);
   } catch (const PluginFault& e) {
-    throw PluginFault(fmt::format("{}; from {}", e.what(), registry.fault_source(e.what(), false)));
+    if (e.origin() == nullptr) throw;
+    throw PluginFault(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))));
   } catch (const NumericalFailure& e) {
-    const std::string source = registry.fault_source(e.what(), true);
-    if (source.empty() || std::string_view(e.what()).find("finite") == std::string_view::npos) throw;
-    throw NumericalFailure(fmt::format("{}; from {}", e.what(), source), e.residual());
+    if (e.origin() == nullptr) throw;
+    throw NumericalFailure(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))),
+                           e.residual());
   }
 }
 

@@ -105,7 +105,7 @@ long steps_for(double t_end, double h) { return std::max(1L, std::lround(t_end /
 Truth exact_truth(Assembly& a, double t_end) {
   Truth truth{Eigen::VectorXd(a.q0.size()), Eigen::VectorXd(a.p0.size()), "exact solution", 0.0};
   Eigen::VectorXd v(a.v0.size());
-  check(a.lagrangian->exact_solution(a.q0.data(), a.v0.data(), t_end, truth.q.data(), v.data()),
+  check(*a.lagrangian, a.lagrangian->exact_solution(a.q0.data(), a.v0.data(), t_end, truth.q.data(), v.data()),
         "exact solution");
   LagrangianEvaluator(*a.lagrangian).legendre(truth.q.data(), v.data(), truth.p.data());
   return truth;

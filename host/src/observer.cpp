@@ -28,7 +28,7 @@ void Observer::observe(const double* q, const double* p) {
   if (what_.energy) values_.push_back(evaluator_.energy(q, v_.data()));
   if (what_.momentum) {
     values_.resize(values_.size() + momentum_size_);
-    check(lagrangian_.momentum(q, v_.data(), values_.data() + values_.size() - momentum_size_), "momentum");
+    check(lagrangian_, lagrangian_.momentum(q, v_.data(), values_.data() + values_.size() - momentum_size_), "momentum");
   }
   if (what_.orthogonality) values_.push_back(manifold_.constraint_error(q));  // ||I - R^T R||_F on SO3
   update_errors();

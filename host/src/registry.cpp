@@ -397,10 +397,14 @@ std::shared_ptr<PluginObject> Registry::create(const std::string& kind, const st
           .dump();
   char error[1024] = {};
   PluginObject* object = loaded.create(parameter_text.c_str(), context_text.c_str(), error, sizeof error);
+  if (object == nullptr && std::strncmp(error, kRefusedParameter, std::strlen(kRefusedParameter)) == 0)
+    throw InputError(fmt::format("{} (the {} plugin {})", error + std::strlen(kRefusedParameter), type,
+                                 record.file.filename().string()));
   if (object == nullptr)
     throw PluginLoadError(fmt::format("{}: {}: {}", record.file.string(), type,
                                       error[0] != '\0' ? error : "the plugin made no object"));
   std::shared_ptr<PluginObject> owned(object, PluginDeleter{loaded.library});
+  owned->set_origin(&record);
   if (kind_name(owned->kind()) != kind)
     throw PluginLoadError(fmt::format("{}: {}: made an object of kind {}, not {}", record.file.string(),
                                       type, kind_name(owned->kind()), kind));
@@ -424,41 +428,10 @@ std::vector<PluginRecord> Registry::list(std::vector<Refusal>& refused) {
 
 std::vector<std::string> Registry::loaded() const { return load_order_; }
 
-namespace {
-
-// The words by which a fault message names the kind of the call that failed (core's check()).
-bool names_kind(const std::string& lower_message, const std::string& kind) {
-  static const std::map<std::string, std::vector<std::string>> words{
-      {"manifold", {"manifold", "retract", "local"}},
-      {"lagrangian", {"lagrangian", "momentum", "group action", "exact solution"}},
-      {"quadrature", {"quadrature"}},
-      {"one_step", {"one-step", "one_step", "one step"}},
-      {"effect", {"effect"}},
-      {"force", {"force"}}};
-  const auto it = words.find(kind);
-  if (it == words.end()) return false;
-  return std::any_of(it->second.begin(), it->second.end(),
-                     [&](const std::string& word) { return lower_message.find(word) != std::string::npos; });
-}
-
 std::string describe(const PluginRecord& record) {
   return fmt::format("{} '{}' ({})", record.kind, record.type, record.file.string());
 }
 
-}  // namespace
-
-std::string Registry::fault_source(const std::string& message, bool only_named) const {
-  std::string lower = message;
-  std::transform(lower.begin(), lower.end(), lower.begin(), [](unsigned char c) { return std::tolower(c); });
-  std::vector<std::string> named, all;
-  for (const auto& [key, loaded] : loaded_) {
-    all.push_back(describe(loaded->record));
-    if (names_kind(lower, loaded->record.kind)) named.push_back(all.back());
-  }
-  if (named.size() == 1) return named.front();
-  if (!named.empty()) return fmt::format("one of: {}", fmt::join(named, ", "));
-  if (only_named || all.empty()) return "";
-  return fmt::format("one of: {}", fmt::join(all, ", "));
-}
+const PluginRecord& Registry::record_of(const void* origin) { return *static_cast<const PluginRecord*>(origin); }
 
 }  // namespace varia::host

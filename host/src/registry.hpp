@@ -47,6 +47,9 @@ struct SymbolScan {
   std::vector<Marker> markers;
 };
 
+// "lagrangian 'pendulum' (<file>)": how messages name a plugin.
+std::string describe(const PluginRecord& record);
+
 class Registry {
  public:
   // The directories searched, in order: the bundled plugins (found relative to the running
@@ -65,7 +68,8 @@ class Registry {
   const PluginRecord& find(const std::string& kind, const std::string& type);
   // Constructs an object of a plugin found with find(); parameters are those of the scene's
   // object (its "type" key removed), already validated against the plugin's schema. Throws
-  // PluginLoadError "<file>: <type>: <message>" when the plugin refuses to construct it.
+  // InputError "<message> (the <type> plugin <file name>)" when the plugin refuses a parameter value
+  // (kRefusedParameter), PluginLoadError "<file>: <type>: <message>" when it fails otherwise.
   std::shared_ptr<PluginObject> create(const std::string& kind, const std::string& type,
                                        const nlohmann::json& parameters,
                                        const sdk::Context& context);
@@ -76,10 +80,9 @@ class Registry {
   }
   // Type names of the plugins loaded so far, in load order (the run record's plugins_loaded).
   std::vector<std::string> loaded() const;
-  // Which loaded plugin a fault message is about, from the kind of call it names ("Lagrangian
-  // gradient: ...", "retract: ..."): "lagrangian 'pendulum' (<file>)"; when no call kind is named,
-  // every loaded plugin ("one of: ..."), or "" when `only_named` or nothing is loaded.
-  std::string fault_source(const std::string& message, bool only_named) const;
+  // The record of the plugin that made an object, from the object's origin (PluginObject::origin,
+  // set by create() to the record, which lives as long as the registry).
+  static const PluginRecord& record_of(const void* origin);
 
  private:
   struct Loaded;

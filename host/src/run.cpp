@@ -65,6 +65,7 @@ struct Failure {
   double t;   // the time it started from
   double residual;
   std::string message;
+  const void* origin = nullptr;  // the plugin object whose output was not finite, if one was
 };
 
 
@@ -185,7 +186,7 @@ class Stepper {
   // An observable found wrong after its step completed: that step failed, from the time it started at.
   Failure observable_failure(const std::string& message, double residual) const {
     const long k = trajectory_.steps();
-    return Failure{k, scene_.t0 + static_cast<double>(std::max(k - 1, 0L)) * scene_.step, residual, message};
+    return Failure{k, scene_.t0 + static_cast<double>(std::max(k - 1, 0L)) * scene_.step, residual, message, nullptr};
   }
 
   // Spec "output.every": every k-th step; step 0 and the last step are always written.

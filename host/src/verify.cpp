@@ -134,7 +134,7 @@ PropertyCheck momentum_conserved(Context& x) {
   run(*x.a.map, x.a.q0, x.a.p0, x.a.t0, x.scene.step, kMomentumRun,
       [&](long step, const double* q, const double* p) {
         v = velocity_of(x, q, p, v);
-        check(x.a.lagrangian->momentum(q, v.data(), J.data()), "momentum map");
+        check(*x.a.lagrangian, x.a.lagrangian->momentum(q, v.data(), J.data()), "momentum map");
         if (step == 0) {
           J0 = J;
           for (double j : J) scale = std::max(scale, std::abs(j));
@@ -167,7 +167,7 @@ ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& refere
   std::vector<double> qa(x.m), va(x.n);
   if (x.a.lagrangian->has_exact_solution()) {
     constexpr double kOffset = 0.37;  // a time along the exact motion with nothing special about it
-    check(x.a.lagrangian->exact_solution(x.a.q0.data(), v0.data(), kOffset, qa.data(), va.data()),
+    check(*x.a.lagrangian, x.a.lagrangian->exact_solution(x.a.q0.data(), v0.data(), kOffset, qa.data(), va.data()),
           "exact solution");
     fine = gauss_legendre(x, 16);
     return {[&x, &fine, qa, va](double h, std::vector<double>& q1, double& LdE) {
@@ -181,7 +181,7 @@ ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& refere
   return {[&x, &reference, v](double h, std::vector<double>& q1, double& LdE) {
             std::vector<double> xi(v);
             for (double& c : xi) c *= h;
-            check(x.a.manifold->retract(x.a.q0.data(), xi.data(), q1.data()), "retract");
+            check(*x.a.manifold, x.a.manifold->retract(x.a.q0.data(), xi.data(), q1.data()), "retract");
             reference.discrete_lagrangian->evaluate(x.a.q0.data(), q1.data(), h, &LdE, nullptr, nullptr);
           },
           std::vector<double>(x.a.q0.data(), x.a.q0.data() + x.m),
@@ -235,7 +235,7 @@ PropertyCheck ld_order(Context& x) {
 
 double state_distance(Context& x, const double* q, const double* p, const double* qe, const double* pe) {
   std::vector<double> xi(x.n);
-  check(x.a.manifold->local(qe, q, xi.data()), "local");
+  check(*x.a.manifold, x.a.manifold->local(qe, q, xi.data()), "local");
   double d = 0.0;
   for (int i = 0; i < x.n; ++i) d = std::max({d, std::abs(xi[i]), std::abs(p[i] - pe[i])});
   return d;
@@ -259,7 +259,7 @@ std::string reference_state(Context& x, double T, double h, std::vector<double>&
   if (has_exact_solution(x.a)) {
     auto v0 = initial_velocity(x);
     std::vector<double> v(x.n);
-    check(x.a.lagrangian->exact_solution(x.a.q0.data(), v0.data(), T, q.data(), v.data()), "exact solution");
+    check(*x.a.lagrangian, x.a.lagrangian->exact_solution(x.a.q0.data(), v0.data(), T, q.data(), v.data()), "exact solution");
     x.lagrangian.legendre(q.data(), v.data(), p.data());
     return "the exact solution";
   }

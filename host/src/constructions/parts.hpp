@@ -18,9 +18,19 @@ inline sdk::Context context_of(const Scene& scene, const Manifold& manifold) {
   return sdk::Context{scene.manifold.type, manifold.point_size(), manifold.dim()};
 }
 
+// The plugin object a scene's plugin spec names; a parameter value the plugin refuses is bad input
+// at the spec's JSON pointer.
+template <class T>
+std::shared_ptr<T> make_part(Registry& registry, const PluginSpec& spec, const sdk::Context& context) {
+  try {
+    return registry.create_as<T>(spec.kind, spec.type, spec.parameters, context);
+  } catch (const InputError& e) {
+    throw InputError(spec.pointer + ": " + e.what());
+  }
+}
 template <class T>
 std::shared_ptr<T> make_part(Registry& registry, const PluginSpec& spec, const Scene& scene, const Manifold& manifold) {
-  return registry.create_as<T>(spec.kind, spec.type, spec.parameters, context_of(scene, manifold));
+  return make_part<T>(registry, spec, context_of(scene, manifold));
 }
 
 inline std::vector<Force*> forces_of(const Assembly& a) {

@@ -41,14 +41,17 @@ struct SolverStatistics {
 
 // A nonlinear solve that did not converge, or a non-finite value. The host adds the step index
 // and time; `residual` is the last residual norm (NaN when not applicable).
+// `origin` is that of the plugin object whose output was not finite (plugin_object.hpp), if one was.
 class NumericalFailure : public std::runtime_error {
  public:
-  NumericalFailure(const std::string& what, double residual)
-      : std::runtime_error(what), residual_(residual) {}
+  NumericalFailure(const std::string& what, double residual, const void* origin = nullptr)
+      : std::runtime_error(what), residual_(residual), origin_(origin) {}
   double residual() const { return residual_; }
+  const void* origin() const { return origin_; }
 
  private:
   double residual_;
+  const void* origin_;
 };
 
 // The time travels with the state: every step is taken from a state (q0, p0) at a time t0 that the

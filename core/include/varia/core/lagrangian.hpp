@@ -34,6 +34,9 @@ class Lagrangian : public PluginObject {
                               Jet2* /*gradient*/) noexcept {
     return "this Lagrangian does not evaluate at jets (derive it from sdk::AutodiffLagrangian)";
   }
+  // Whether gradient_jet is implemented: constructions that need it refuse the Lagrangian when
+  // they are built (`validate`, exit 2) rather than at the first step.
+  virtual bool evaluates_at_jets() const noexcept { return false; }
 
   // The declared symmetry (Noether): a group name ("none", "SO(2)", "SO(3)", ...), the size of
   // its momentum map J(q, v) = <dL/dv, xi_Q(q)>, and the lifted action of a pseudo-random group

@@ -59,7 +59,7 @@ class LagrangianEvaluator {
   [[noreturn]] static void not_finite(const char* what);
   // The gradient, and L where value is not null.
   void evaluate_gradient(const double* q, const double* v, double* value, double* gradient) {
-    check(lagrangian_.evaluate(q, v, value, gradient, nullptr), "Lagrangian gradient");
+    check(lagrangian_, lagrangian_.evaluate(q, v, value, gradient, nullptr), "Lagrangian gradient");
     ++counters_.gradient;
     check_finite(gradient, m_ + n_, "gradient");
   }

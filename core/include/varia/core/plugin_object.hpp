@@ -12,10 +12,16 @@ namespace varia {
 
 // Bumped whenever a virtual interface below or in the kind headers changes layout.
 // 2: Lagrangian::gradient_jet, OneStepMethod; 3: Manifold::constraint_error; 4: VectorField's
-// Lie group hooks (algebra, move); 5: Manifold::chart_jets, Manifold::local_jets.
-inline constexpr int kAbiVersion = 5;
+// Lie group hooks (algebra, move); 5: Manifold::chart_jets, Manifold::local_jets;
+// 6: Lagrangian::evaluates_at_jets, PluginObject::origin.
+inline constexpr int kAbiVersion = 6;
 
 using Status = const char*;
+
+// How a plugin's factory marks the refusal of a parameter value (a std::invalid_argument in the
+// SDK), so that the host reports it as bad input at the parameter's JSON pointer (exit 2) rather
+// than as a plugin fault (exit 3).
+inline constexpr const char* kRefusedParameter = "refused parameter: ";
 
 // The plugin kinds. New kinds are appended; existing ones keep their interfaces.
 enum class Kind { manifold, quadrature, lagrangian, one_step, effect, force };
@@ -24,17 +30,30 @@ class PluginObject {
  public:
   virtual ~PluginObject() = default;
   virtual Kind kind() const noexcept = 0;
+  // Who made the object, set by the host when it creates it (its plugin record; opaque to the
+  // plugin and to the core) and carried by every fault the core raises about the object, so that
+  // a fault names its plugin from the object that failed, not from the words of its message.
+  const void* origin() const noexcept { return origin_; }
+  void set_origin(const void* origin) noexcept { origin_ = origin; }
+
+ private:
+  const void* origin_ = nullptr;
 };
 
-// A plugin call that failed: thrown on the host side only.
+// A plugin call that failed: thrown on the host side only, with the failing object's origin.
 class PluginFault : public std::runtime_error {
  public:
-  using std::runtime_error::runtime_error;
+  explicit PluginFault(const std::string& what, const void* origin = nullptr)
+      : std::runtime_error(what), origin_(origin) {}
+  const void* origin() const { return origin_; }
+
+ private:
+  const void* origin_;
 };
 
-// Converts a plugin Status into a PluginFault naming the call that failed.
-inline void check(Status status, const char* what) {
-  if (status != nullptr) throw PluginFault(std::string(what) + ": " + status);
+// Converts the Status of a call of `source` into a PluginFault naming the call that failed.
+inline void check(const PluginObject& source, Status status, const char* what) {
+  if (status != nullptr) throw PluginFault(std::string(what) + ": " + status, source.origin());
 }
 
 }  // namespace varia

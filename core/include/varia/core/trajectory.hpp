@@ -16,6 +16,8 @@ namespace varia {
 // happened in (the step from `step` - 1 to `step`) and the time that step started from.
 class StepFailure : public NumericalFailure {
  public:
+  StepFailure(const NumericalFailure& failure, long step, double t)
+      : NumericalFailure(failure.what(), failure.residual(), failure.origin()), step_(step), t_(t) {}
   StepFailure(const std::string& what, double residual, long step, double t)
       : NumericalFailure(what, residual), step_(step), t_(t) {}
   long step() const { return step_; }

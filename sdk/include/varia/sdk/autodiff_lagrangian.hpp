@@ -73,6 +73,7 @@ class AutodiffLagrangian : public Lagrangian {
     });
   }
 
+  bool evaluates_at_jets() const noexcept final { return true; }
   Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final {
     return guarded(error_, [&] {
       if (m_ + n_ > kMaxJetInputs)

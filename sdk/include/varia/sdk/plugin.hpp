@@ -79,6 +79,8 @@ PluginObject* create(const char* parameters, const char* context, char* error,
   std::string message;
   try {
     return new Class(nlohmann::json::parse(parameters), parse_context(context));
+  } catch (const std::invalid_argument& e) {  // a parameter value the plugin refuses: bad input
+    message = std::string(kRefusedParameter) + e.what();
   } catch (const std::exception& e) {
     message = e.what();
   } catch (...) {

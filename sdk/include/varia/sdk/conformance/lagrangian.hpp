@@ -33,7 +33,7 @@ inline Evaluation evaluate(Lagrangian& lagrangian, const VectorXd& q, const Vect
   const int stored = lagrangian.hessian_pattern(&rows, &cols);
   Evaluation e{0.0, VectorXd(k), MatrixXd::Zero(k, k)};
   VectorXd entries(stored < 0 ? k * k : stored);
-  check(lagrangian.evaluate(q.data(), v.data(), &e.value, e.gradient.data(), entries.data()), "evaluate");
+  check(lagrangian, lagrangian.evaluate(q.data(), v.data(), &e.value, e.gradient.data(), entries.data()), "evaluate");
   if (stored < 0) e.hessian = entries.reshaped(k, k);
   for (int i = 0; i < stored; ++i) e.hessian(rows[i], cols[i]) = entries(i);
   return e;
@@ -41,13 +41,13 @@ inline Evaluation evaluate(Lagrangian& lagrangian, const VectorXd& q, const Vect
 
 inline double value(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v) {
   double l = 0;
-  check(lagrangian.evaluate(q.data(), v.data(), &l, nullptr, nullptr), "evaluate");
+  check(lagrangian, lagrangian.evaluate(q.data(), v.data(), &l, nullptr, nullptr), "evaluate");
   return l;
 }
 
 inline VectorXd gradient(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v) {
   VectorXd g(lagrangian.position_size() + lagrangian.velocity_size());
-  check(lagrangian.evaluate(q.data(), v.data(), nullptr, g.data(), nullptr), "evaluate");
+  check(lagrangian, lagrangian.evaluate(q.data(), v.data(), nullptr, g.data(), nullptr), "evaluate");
   return g;
 }
 
@@ -97,11 +97,11 @@ inline void check_symmetry(Lagrangian& lagrangian, unsigned seed, const VectorXd
                            Failures& failures) {
   const int m = lagrangian.position_size(), n = lagrangian.velocity_size();
   VectorXd gq(m), gv(n), j(lagrangian.momentum_size()), gj(lagrangian.momentum_size());
-  check(lagrangian.act(seed, q.data(), v.data(), gq.data(), gv.data()), "act");
+  check(lagrangian, lagrangian.act(seed, q.data(), v.data(), gq.data(), gv.data()), "act");
   const double gl = value(lagrangian, gq, gv);
   failures.expect(gap(gl, l) <= 1e-13, "L(g q, g v) = ", gl, " differs from L(q, v) = ", l);
-  check(lagrangian.momentum(q.data(), v.data(), j.data()), "momentum");
-  check(lagrangian.momentum(gq.data(), gv.data(), gj.data()), "momentum");
+  check(lagrangian, lagrangian.momentum(q.data(), v.data(), j.data()), "momentum");
+  check(lagrangian, lagrangian.momentum(gq.data(), gv.data(), gj.data()), "momentum");
   failures.expect(gap(gj.norm(), j.norm()) <= 1e-13, "|J(g q, g v)| = ", gj.norm(),
                   " differs from |J(q, v)| = ", j.norm(), " (Ad*-equivariance)");
 }
