@@ -180,8 +180,8 @@ TEST_CASE("the Lagrangian plugins refuse unsupported manifolds and bad parameter
                     "pendulum needs manifold Rn with dim 1, got SO3 with dim 3");
   CHECK_THROWS_WITH(make("kepler", none, rn(1)),
                     "kepler needs manifold Rn with dim 2 to 3, got Rn with dim 1");
-  CHECK_THROWS_WITH(make("harmonic_oscillator", none, rn(9)),
-                    "harmonic-oscillator needs manifold Rn with dim 1 to 8, got Rn with dim 9");
+  CHECK_THROWS_WITH(make("harmonic_oscillator", none, rn(10)),
+                    "harmonic-oscillator needs manifold Rn with dim 1 to 9, got Rn with dim 10");
   CHECK_THROWS_WITH(make("pendulum", {{"length", 0}}, rn(1)),
                     "parameter 'length' must be a number > 0, got 0");
   CHECK_THROWS_WITH(make("kepler", {{"mu", "one"}}, rn(2)),
