@@ -31,9 +31,6 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
       s_(static_cast<int>(control_times.size()) - 1) {
   if (lagrangian.position_size() != m_ || lagrangian.velocity_size() != n_)
     throw std::invalid_argument("the Lagrangian's sizes do not match the manifold's");
-  if (2 * n_ > kMaxJetVariables)
-    throw std::invalid_argument("the Galerkin construction on a Lie group needs dim <= " +
-                                std::to_string(kMaxJetVariables / 2) + " (its chart at jets)");
   if (reduced_ && !invariant_under_the_whole_group(lagrangian, n_))
     throw std::invalid_argument(
         "the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group "
@@ -49,7 +46,11 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
   previous_base_.resize(m_);
   last_end_.resize(m_);
   point_.resize(m_);
+  point_gradient_.resize(m_ * 2 * n_);
+  point_hessian_.resize(m_ * 4 * n_ * n_);
   velocity_.resize(n_);
+  velocity_gradient_.resize(n_ * 2 * n_);
+  velocity_hessian_.resize(n_ * 4 * n_ * n_);
   node_xi_.resize(n_);
   node_rate_.resize(n_);
   q_.resize(m_);
@@ -75,7 +76,7 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
 }
 
 void LieGroupGalerkinDiscreteLagrangian::check(Status status) const {
-  varia::check(manifold_, status, "manifold chart_jets");
+  varia::check(manifold_, status, "manifold chart");
 }
 
 // One quadrature node of the action: z = (g, Omega) of the chart curve as jets in the node's
@@ -87,22 +88,30 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
   node_xi_.noalias() = xi_ * basis_.phi.col(i);
   node_rate_.noalias() = xi_ * basis_.dphi.col(i) / h;
   const int n = n_;
-  check(manifold_.chart_jets(q0, node_xi_.data(), node_rate_.data(),
-                             reduced_ ? nullptr : point_.data(), velocity_.data()));
-  for (int k = 0; k < m_; ++k) q_(k) = reduced_ ? q0[k] : point_[k].value;  // reduced: l = L(g0, .)
-  for (int k = 0; k < n; ++k) v_(k) = velocity_[k].value;
+  const Derivatives point = reduced_ ? Derivatives{} : Derivatives{point_.data(), point_gradient_.data(),
+                                                                   with_hessian ? point_hessian_.data() : nullptr};
+  check(manifold_.chart(q0, node_xi_.data(), node_rate_.data(), point,
+                        {velocity_.data(), velocity_gradient_.data(), with_hessian ? velocity_hessian_.data() : nullptr}));
+  for (int k = 0; k < m_; ++k) q_(k) = reduced_ ? q0[k] : point_[k];  // reduced: l = L(g0, .)
+  for (int k = 0; k < n; ++k) v_(k) = velocity_[k];
   const double L = with_hessian ? lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data())
                                 : lagrangian_.value_and_gradient(q_.data(), v_.data(), grad_.data());
+  // Row k of the chart's gradient in (eta, xi) or (xi, xi_dot), and its Hessian, as matrices.
+  const auto row = [&](const Eigen::VectorXd& gradient, int k) { return gradient.segment(k * 2 * n, 2 * n).transpose(); };
+  const auto hessian = [&](const Eigen::VectorXd& h, int k) {
+    return Eigen::Map<const Eigen::MatrixXd>(h.data() + k * 4 * n * n, 2 * n, 2 * n);
+  };
   if (!reduced_)
-    for (int k = 0; k < m_; ++k) chain_.row(k).head(2 * n) = point_[k].gradient.transpose();
-  for (int k = 0; k < n; ++k) chain_.row(m_ + k).tail(2 * n) = velocity_[k].gradient.transpose();
+    for (int k = 0; k < m_; ++k) chain_.row(k).head(2 * n) = row(point_gradient_, k);
+  for (int k = 0; k < n; ++k) chain_.row(m_ + k).tail(2 * n) = row(velocity_gradient_, k);
   node_gradient_.noalias() = chain_.transpose() * grad_;
   if (with_hessian) {
     hess_chain_.noalias() = hess_ * chain_;
     node_hessian_.noalias() = chain_.transpose() * hess_chain_;
     if (!reduced_)
-      for (int k = 0; k < m_; ++k) node_hessian_.topLeftCorner(2 * n, 2 * n) += grad_(k) * point_[k].hessian;
-    for (int k = 0; k < n; ++k) node_hessian_.bottomRightCorner(2 * n, 2 * n) += grad_(m_ + k) * velocity_[k].hessian;
+      for (int k = 0; k < m_; ++k) node_hessian_.topLeftCorner(2 * n, 2 * n) += grad_(k) * hessian(point_hessian_, k);
+    for (int k = 0; k < n; ++k)
+      node_hessian_.bottomRightCorner(2 * n, 2 * n) += grad_(m_ + k) * hessian(velocity_hessian_, k);
   }
 
   // The weight of node block a (0 eta, 1 xi, 2 xi_dot) in the action's block beta (0 eta, nu >= 1
@@ -142,11 +151,13 @@ void LieGroupGalerkinDiscreteLagrangian::dexp_with_derivatives(const double* q0,
                                                               double sign) {
   node_xi_ = -sign * Eigen::Map<const Eigen::VectorXd>(w, n_);
   node_rate_.setZero();
-  check(manifold_.chart_jets(q0, node_xi_.data(), node_rate_.data(), nullptr, velocity_.data()));
+  check(manifold_.chart(q0, node_xi_.data(), node_rate_.data(), {},
+                        {nullptr, velocity_gradient_.data(), velocity_hessian_.data()}));
+  const int V = 2 * n_;
   for (int k = 0; k < n_; ++k) {
-    dexp_.row(k) = velocity_[k].gradient.tail(n_).transpose();
+    dexp_.row(k) = velocity_gradient_.segment(k * V + n_, n_).transpose();
     for (int l = 0; l < n_; ++l)
-      dexp_derivative_[l].row(k) = -velocity_[k].hessian.block(l, n_, 1, n_);
+      for (int j = 0; j < n_; ++j) dexp_derivative_[l](k, j) = -velocity_hessian_[(k * V + l) * V + n_ + j];
   }
   dexp_lu_.compute(dexp_);
   dexp_inverse_T_ = dexp_lu_.inverse();

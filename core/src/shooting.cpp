@@ -110,6 +110,13 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   acceleration_.resize(n_);
   gradient_.resize(m_ + n_);
   boundary_.resize(n_);
+  end_.resize(m_);
+  chart_value_.resize(m_);
+  chart_gradient_.resize(2 * m_ * n_);
+  chart_hessian_.resize(4 * m_ * n_ * n_);
+  local_value_.resize(n_);
+  local_gradient_.resize(n_ * m_);
+  local_hessian_.resize(n_ * m_ * m_);
   w_.resize(n_);
   lambda_.resize(n_);
   D1_.resize(n_);
@@ -160,19 +167,25 @@ void ShootingDiscreteLagrangian::add_work(double weight) {
 
 // q^0 = q0 exp(eta) at eta = 0 as jets in x = (eta, w0), the natural chart at q0 (paper, sec. 2
 // "Natural charts"): eta carries D1 L_d, left-trivialized on a Lie group. On a vector space the
-// chart is q0 + eta; otherwise the manifold's chart_jets gives q0 exp(eta) exp(xi) in (eta, xi),
+// chart is q0 + eta; otherwise the manifold's chart gives q0 exp(eta) exp(xi) in (eta, xi),
 // whose xi-derivatives (xi = 0) are dropped: the variables n..2n-1 are w0 here.
 void ShootingDiscreteLagrangian::start_point(const double* q0) {
   if (manifold_.is_vector_space()) {
     for (int r = 0; r < n_; ++r) state_[r] = Jet2::variable(q0[r], 2 * n_, r);
     return;
   }
-  check(manifold_, manifold_.chart_jets(q0, zero_.data(), zero_.data(), state_.data(), nullptr), "manifold chart at jets");
+  const int V = 2 * n_;
+  check(manifold_, manifold_.chart(q0, zero_.data(), zero_.data(),
+                        {chart_value_.data(), chart_gradient_.data(), chart_hessian_.data()}, {}),
+        "manifold chart");
   for (int r = 0; r < m_; ++r) {
-    if (state_[r].constant()) continue;
-    state_[r].gradient.tail(n_).setZero();
-    state_[r].hessian.bottomRows(n_).setZero();
-    state_[r].hessian.rightCols(n_).setZero();
+    Jet2& q = state_[r] = Jet2::variable(chart_value_[r], V, 0);
+    q.gradient.setZero();
+    q.hessian.setZero();
+    for (int a = 0; a < n_; ++a) {
+      q.gradient(a) = chart_gradient_[r * V + a];
+      for (int b = 0; b < n_; ++b) q.hessian(a, b) = chart_hessian_[(r * V + a) * V + b];
+    }
   }
 }
 
@@ -215,7 +228,28 @@ void ShootingDiscreteLagrangian::boundary() {
   }
   if (target_is_end_)
     for (int r = 0; r < m_; ++r) target_[r] = state_[r].value;
-  check(manifold_, manifold_.local_jets(target_.data(), state_.data(), boundary_.data()), "manifold chart at jets");
+  for (int r = 0; r < m_; ++r) end_[r] = state_[r].value;
+  check(manifold_, manifold_.local_derivatives(target_.data(), end_.data(),
+                                    {local_value_.data(), local_gradient_.data(), local_hessian_.data()}),
+        "manifold local_derivatives");
+  // The chain rule from the point's jets: B_r = sum_k dB_r/dq_k q_k (first and second order).
+  const int V = 2 * n_;
+  for (int r = 0; r < n_; ++r) {
+    Jet2& b = boundary_[r] = Jet2::variable(local_value_[r], V, 0);
+    b.gradient.setZero();
+    b.hessian.setZero();
+    for (int k = 0; k < m_; ++k) {
+      const Jet2& q = state_[k];
+      if (q.constant()) continue;
+      const double d = local_gradient_[r * m_ + k];
+      b.gradient += d * q.gradient;
+      b.hessian += d * q.hessian;
+      for (int l = 0; l < m_; ++l) {
+        const double dd = local_hessian_[(r * m_ + k) * m_ + l];
+        if (dd != 0.0 && !state_[l].constant()) b.hessian.noalias() += dd * q.gradient * state_[l].gradient.transpose();
+      }
+    }
+  }
 }
 
 // lambda = B_w^{-T} alpha_w, D1 = alpha_q - B_q^T lambda, Phi = d alpha/dx - sum_r lambda_r Hess B_r,

@@ -135,14 +135,14 @@ namespace {
 
 // The one-step map in canonical coordinates z = (xi, pi) of T*Q: xi in the natural chart at
 // `base`, pi = B^T mu the chart's conjugate momentum, where mu is the (left-trivialized) momentum
-// and B = d velocity / d xi_dot = dexp_{-xi} (Manifold::chart_jets; the identity on a vector
+// and B = d velocity / d xi_dot = dexp_{-xi} (Manifold::chart; the identity on a vector
 // space, where z = (q - base, p)).
 class CanonicalChart {
  public:
   CanonicalChart(DiscreteHamiltonianMap& map, Manifold& manifold, const double* base)
       : map_(map), manifold_(manifold), base_(base, base + manifold.point_size()),
         n_(manifold.dim()), q_(manifold.point_size()), q1_(manifold.point_size()), mu_(n_), mu1_(n_),
-        B_(n_, n_), jets_(n_) {}
+        B_(n_, n_), velocity_gradient_(2 * n_ * n_) {}
   void step(const Eigen::VectorXd& z, double h, Eigen::VectorXd& out) {
     check(manifold_, manifold_.retract(base_.data(), z.data(), q_.data()), "manifold retract");
     chart_momentum_matrix(z.data());
@@ -160,8 +160,9 @@ class CanonicalChart {
       return;
     }
     const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
-    check(manifold_, manifold_.chart_jets(base_.data(), xi, zero.data(), nullptr, jets_.data()), "manifold chart_jets");
-    for (int k = 0; k < n_; ++k) B_.row(k) = jets_[k].gradient.tail(n_).transpose();
+    check(manifold_, manifold_.chart(base_.data(), xi, zero.data(), {}, {nullptr, velocity_gradient_.data(), nullptr}),
+          "manifold chart");
+    for (int k = 0; k < n_; ++k) B_.row(k) = velocity_gradient_.segment(k * 2 * n_ + n_, n_).transpose();
   }
   DiscreteHamiltonianMap& map_;
   Manifold& manifold_;
@@ -170,7 +171,7 @@ class CanonicalChart {
   std::vector<double> q_, q1_;
   Eigen::VectorXd mu_, mu1_;
   Eigen::MatrixXd B_;
-  std::vector<Jet2> jets_;
+  Eigen::VectorXd velocity_gradient_;  // d velocity / d (xi, xi_dot), component-major
 };
 
 // Central-difference Jacobian of the one-step map in canonical chart coordinates at

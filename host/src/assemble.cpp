@@ -35,15 +35,15 @@ void check_lagrangian_fits(const Scene& scene, const Lagrangian& lagrangian, con
       manifold.point_size(), manifold.dim()));
 }
 
-// Spec "observe": momentum needs a declared symmetry; orthogonality is for SO3 only.
+// Spec "observe": momentum needs a declared symmetry; orthogonality a manifold embedded with a
+// constraint (the rotation matrix of SO3 and SE3: Manifold::has_constraint).
 void check_observables(const Scene& scene, Lagrangian& lagrangian, const Manifold& manifold) {
   if (scene.observe.momentum && lagrangian.momentum_size() <= 0)
     throw InputError(fmt::format("/observe: expected no \"momentum\": the {} Lagrangian declares no symmetry",
                                  scene.lagrangian.type));
-  const bool rotations = manifold.point_size() == 9 && manifold.dim() == 3 && !manifold.is_vector_space();
-  if (scene.observe.orthogonality && !rotations)
+  if (scene.observe.orthogonality && !manifold.has_constraint())
     throw InputError(fmt::format(
-        "/observe: expected no \"orthogonality\": it is defined on SO3 only, and the manifold is {}",
+        "/observe: expected no \"orthogonality\": it is defined on SO3 and SE3 only, and the manifold is {}",
         scene.manifold.type));
 }
 

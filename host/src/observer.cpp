@@ -30,7 +30,7 @@ void Observer::observe(const double* q, const double* p) {
     values_.resize(values_.size() + momentum_size_);
     check(lagrangian_, lagrangian_.momentum(q, v_.data(), values_.data() + values_.size() - momentum_size_), "momentum");
   }
-  if (what_.orthogonality) values_.push_back(manifold_.constraint_error(q));  // ||I - R^T R||_F on SO3
+  if (what_.orthogonality) values_.push_back(manifold_.constraint_error(q));  // ||I - R^T R||_F on SO3 and SE3
   update_errors();
 }
 

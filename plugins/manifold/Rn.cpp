@@ -3,6 +3,7 @@
 // "Natural charts": psi_{q0}^{-1}(xi) = q0 exp(xi)) is affine:
 //   retract: q = q0 + xi,    local: xi = q - q0.
 // A point is any n finite numbers; points, tangent vectors and momenta all have n numbers.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
@@ -63,23 +64,32 @@ class Rn final : public varia::Manifold {
     return nullptr;
   }
 
-  // The affine chart at jets: point q0 + eta + xi in (eta, xi), velocity xi_dot in (xi, xi_dot).
-  varia::Status chart_jets(const double* q0, const double* xi, const double* xi_dot,
-                           varia::Jet2* point, varia::Jet2* velocity) noexcept override {
-    if (2 * n_ > varia::kMaxJetVariables) return "the chart of R^n at jets needs n <= 4";
-    for (int i = 0; i < n_; ++i) {
-      if (point != nullptr) {
-        point[i] = varia::Jet2::variable(q0[i] + xi[i], 2 * n_, i);
-        point[i].gradient(n_ + i) = 1.0;
+  // The affine chart to second order: point q0 + eta + xi in (eta, xi), velocity xi_dot in
+  // (xi, xi_dot); both linear, so their Hessians are zero.
+  varia::Status chart(const double* q0, const double* xi, const double* xi_dot, varia::Derivatives point,
+                      varia::Derivatives velocity) noexcept override {
+    const long V = 2L * n_;
+    for (long i = 0; i < n_; ++i) {
+      if (point.value != nullptr) point.value[i] = q0[i] + xi[i];
+      if (velocity.value != nullptr) velocity.value[i] = xi_dot[i];
+      for (long a = 0; a < V; ++a) {
+        if (point.gradient != nullptr) point.gradient[i * V + a] = a == i || a == n_ + i ? 1.0 : 0.0;
+        if (velocity.gradient != nullptr) velocity.gradient[i * V + a] = a == n_ + i ? 1.0 : 0.0;
       }
-      if (velocity != nullptr) velocity[i] = varia::Jet2::variable(xi_dot[i], 2 * n_, n_ + i);
     }
+    for (double* hessian : {point.hessian, velocity.hessian})
+      if (hessian != nullptr) std::fill_n(hessian, n_ * V * V, 0.0);
     return nullptr;
   }
 
-  // The affine chart's inverse at jets: xi = q - q0.
-  varia::Status local_jets(const double* q0, const varia::Jet2* q, varia::Jet2* xi) noexcept override {
-    for (int i = 0; i < n_; ++i) xi[i] = q[i] - q0[i];
+  // The affine chart's inverse: xi = q - q0, gradient the identity, Hessian zero.
+  varia::Status local_derivatives(const double* q0, const double* q, varia::Derivatives xi) noexcept override {
+    for (long i = 0; i < n_; ++i) {
+      if (xi.value != nullptr) xi.value[i] = q[i] - q0[i];
+      if (xi.gradient != nullptr)
+        for (long a = 0; a < n_; ++a) xi.gradient[i * n_ + a] = a == i ? 1.0 : 0.0;
+    }
+    if (xi.hessian != nullptr) std::fill_n(xi.hessian, static_cast<long>(n_) * n_ * n_, 0.0);
     return nullptr;
   }
 

@@ -8,6 +8,7 @@
 #include "varia/core/quadrature.hpp"
 #include "varia/core/so3.hpp"
 #include "varia/sdk/autodiff_lagrangian.hpp"
+#include "varia/sdk/groups/so3.hpp"
 
 namespace varia::testing {
 
@@ -80,30 +81,9 @@ struct Pendulums : sdk::AutodiffLagrangian<Pendulums> {
   int n_;
 };
 
-// SO(3) in process (varia/core/so3.hpp): points are row-major rotation matrices.
-struct Rotations : Manifold {
-  int point_size() const noexcept override { return 9; }
-  int dim() const noexcept override { return 3; }
-  bool is_vector_space() const noexcept override { return false; }
-  Status retract(const double* q0, const double* xi, double* q) noexcept override {
-    so3::to_row_major(so3::from_row_major(q0) * so3::exp(Eigen::Vector3d(xi[0], xi[1], xi[2])), q);
-    return nullptr;
-  }
-  Status local(const double* q0, const double* q, double* xi) noexcept override {
-    so3::chart_local(q0, q, xi);
-    return nullptr;
-  }
-  Status chart_jets(const double* q0, const double* xi, const double* xi_dot, Jet2* point,
-                    Jet2* velocity) noexcept override {
-    so3::chart_jets(q0, xi, xi_dot, point, velocity);
-    return nullptr;
-  }
-  Status local_jets(const double* q0, const Jet2* q, Jet2* xi) noexcept override {
-    so3::chart_local(q0, q, xi);
-    return nullptr;
-  }
-  bool contains(const double*, char*, int) noexcept override { return true; }
-};
+// SO(3) in process (varia/sdk/groups/so3.hpp, as the SO3 plugin): points are row-major rotation
+// matrices.
+struct Rotations : sdk::groups::RotationGroup {};
 
 // A top with principal moments J and weight w = m g at the body offset chi (w = 0: the free rigid
 // body): L = 1/2 Omega . J Omega - w e3 . (R chi), R row-major in q.

@@ -45,7 +45,7 @@ std::unique_ptr<LieGroupGalerkinDiscreteLagrangian> make(Manifold& group, Lagran
 struct ChartAtJets {
   ChartAtJets() {
     so3::to_row_major(so3::exp(Vector3d(0.3, -0.7, 1.1)), R0);
-    REQUIRE(group.chart_jets(R0, xi.data(), rate.data(), point, velocity) == nullptr);
+    so3::chart_jets(R0, xi.data(), rate.data(), point, velocity);
   }
   Rotations group;
   double R0[9];
@@ -98,8 +98,8 @@ TEST_CASE_FIXTURE(ChartAtJets, "SO3 chart jets: second derivatives agree with di
   for (int l = 0; l < 3; ++l) {
     Jet2 plus[9], minus[9], vplus[3], vminus[3];
     const Vector3d a = xi + e * Vector3d::Unit(l), b = xi - e * Vector3d::Unit(l);
-    REQUIRE(group.chart_jets(R0, a.data(), rate.data(), plus, vplus) == nullptr);
-    REQUIRE(group.chart_jets(R0, b.data(), rate.data(), minus, vminus) == nullptr);
+    so3::chart_jets(R0, a.data(), rate.data(), plus, vplus);
+    so3::chart_jets(R0, b.data(), rate.data(), minus, vminus);
     for (int k = 0; k < 9; ++k)
       for (int j = 0; j < 6; ++j)  // d/dxi_l of dR/d(eta, xi)_j
         worst = std::max(worst, std::abs(point[k].hessian(j, 3 + l) -

@@ -42,7 +42,7 @@ const std::map<std::string, std::string> kBadScenes{
     {"unknown-observable.json", "/observe/0: expected one of \"energy\""},
     // unknown plugin types, listing the valid ones
     {"unknown-lagrangian.json", "/system/lagrangian/type: unknown lagrangian type 'pendulm'; valid lagrangian types are: "},
-    {"unknown-manifold.json", "/system/manifold/type: unknown manifold type 'R3'; valid manifold types are: Rn, SO3"},
+    {"unknown-manifold.json", "/system/manifold/type: unknown manifold type 'R3'; valid manifold types are: Rn, SE3, SO3"},
     {"unknown-quadrature.json", "/method/quadrature/type: unknown quadrature type 'gauss'; valid quadrature types are: "},
     // out-of-range parameters
     {"bad-quadrature-parameter.json", "/method/quadrature/points: expected an integer >= 2"},
@@ -69,6 +69,7 @@ const std::map<std::string, std::string> kBadScenes{
     {"composite-with-shooting.json", "/method: the shooting construction propagates jets through the Euler-Lagrange field, and this Lagrangian does not evaluate at jets"},
     {"p-and-v.json", "/initial/p: not allowed here"},
     {"reduced-heavy-top.json", "/method/reduced: the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group"},
+    {"reduced-se3-spring.json", "/method/reduced: the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group"},
     {"reduced-on-rn.json", "/method/reduced: the reduced (Euler-Poincare) form is for Lie groups"},
     {"reduced-with-shooting.json", "/method/reduced: unknown key 'reduced'; the keys allowed here are: construction, form"},
     {"so3-not-orthogonal.json", "/initial/q: expected a point of SO3: R is not orthogonal"},

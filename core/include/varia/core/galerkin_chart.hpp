@@ -15,7 +15,7 @@
 //                                           -dexp_{xi^s}^{-1} eta).
 // The discrete Hamiltonian map solves p0 = -D1 L_d with the internal conditions for xi^1..xi^s by
 // Newton's method with the exact Jacobian: the manifold gives its chart at second-order jets
-// (Manifold::chart_jets), the Lagrangian its dense Hessian, and the chain rule their product.
+// (Manifold::chart), the Lagrangian its dense Hessian, and the chain rule their product.
 //
 // Reduced form (sec. 2, "Higher-order discrete Euler-Poincare equations"), for a Lagrangian
 // invariant under the whole group (momentum_size() == dim()): L(g, Omega) = l(Omega), so tau = 0
@@ -31,7 +31,6 @@
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/core/galerkin.hpp"
-#include "varia/core/jet.hpp"
 #include "varia/core/manifold.hpp"
 #include "varia/core/mechanics.hpp"
 #include "varia/core/quadrature.hpp"
@@ -40,8 +39,7 @@ namespace varia {
 
 class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHamiltonianMap {
  public:
-  // Throws std::invalid_argument when the manifold gives no chart at jets or the reduced form is
-  // asked of a Lagrangian not invariant under the whole group.
+  // Throws std::invalid_argument when the reduced form is asked of a Lagrangian not invariant under the whole group.
   LieGroupGalerkinDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian,
                                      Quadrature& quadrature, std::vector<double> control_times,
                                      SolverOptions options, bool reduced = false);
@@ -92,7 +90,8 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   Eigen::VectorXd previous_base_, last_end_;  // the last step's g0 and g1
   double previous_h_ = 0.0;
   bool has_previous_ = false;
-  std::vector<Jet2> point_, velocity_;
+  // The chart at a node (Manifold::chart): values, gradients and Hessians, component-major.
+  Eigen::VectorXd point_, point_gradient_, point_hessian_, velocity_, velocity_gradient_, velocity_hessian_;
   Eigen::VectorXd node_xi_, node_rate_, q_, v_, grad_, node_gradient_;
   Eigen::MatrixXd hess_, chain_, hess_chain_, node_hessian_;
   double action_ = 0.0;        // S at the last evaluation

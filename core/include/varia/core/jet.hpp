@@ -164,6 +164,10 @@ inline Jet2 cos(const Jet2& a) {
   const double c = std::cos(a.value);
   return jet::unary(a, c, -std::sin(a.value), -c);
 }
+inline Jet2 tan(const Jet2& a) {
+  const double t = std::tan(a.value), d = 1 + t * t;
+  return jet::unary(a, t, d, 2 * t * d);
+}
 inline Jet2 exp(const Jet2& a) {
   const double e = std::exp(a.value);
   return jet::unary(a, e, e, e);

@@ -1,13 +1,28 @@
 // Configuration manifold Q with a natural chart (paper, sec. 2 "Natural charts"):
 // psi_{q0}^{-1}(xi) = q0 exp(xi) (retract) and psi_{q0}(q) = log(q0^{-1} q) (local).
-// A point is point_size() numbers (n on R^n; 9 on SO(3), a row-major rotation matrix); tangent
-// vectors, velocities and momenta are dim() numbers, left-trivialized on a Lie group.
+// A point is point_size() numbers (n on R^n; 9 on SO(3), a row-major rotation matrix; 12 on
+// SE(3), R then x); tangent vectors, velocities and momenta are dim() numbers, left-trivialized
+// on a Lie group.
+//
+// A manifold declares its structure: a vector space (is_vector_space(), the chart is affine), or
+// a Lie group whose natural chart it gives to second order (chart, local_derivatives). The
+// derivatives cross the boundary as plain arrays sized by the caller, so no capacity of the
+// interface limits the group's dimension. A plugin author writes the group's operations once,
+// templated on the scalar, and the SDK's adapter (varia/sdk/lie_group.hpp) derives these.
 #pragma once
 
-#include "varia/core/jet.hpp"
 #include "varia/core/plugin_object.hpp"
 
 namespace varia {
+
+// A quantity of k components and its first and second derivatives in V variables, in buffers the
+// caller sizes: value k numbers, gradient k x V, hessian k x V x V, component-major (the gradient
+// of component c starts at c V, its symmetric Hessian at c V^2). A null buffer is not written.
+struct Derivatives {
+  double* value = nullptr;
+  double* gradient = nullptr;
+  double* hessian = nullptr;
+};
 
 class Manifold : public PluginObject {
  public:
@@ -22,23 +37,26 @@ class Manifold : public PluginObject {
   // Checks that q is a point of the manifold (to a tolerance); fills `why` when it is not.
   virtual bool contains(const double* q, char* why, int why_size) noexcept = 0;
   // How far q lies off the manifold in its embedding, for the run's drift observables:
-  // ||I - R^T R||_F on SO(3) (the paper's orthogonality error); 0 where every point is valid.
+  // ||I - R^T R||_F on SO(3) and SE(3) (the paper's orthogonality error); 0 where every point is
+  // valid (has_constraint() false).
   virtual double constraint_error(const double* /*q*/) const noexcept { return 0.0; }
+  virtual bool has_constraint() const noexcept { return false; }
   // The natural chart to second order, for the Galerkin construction on a Lie group (paper,
   // sec. 2, "Natural charts"): with n = dim(),
-  //   point:    q0 exp(eta) exp(xi) at eta = 0, point_size() jets in the 2n variables (eta, xi);
+  //   point:    q0 exp(eta) exp(xi) at eta = 0, point_size() components in the 2n variables
+  //             (eta, xi);
   //   velocity: the left-trivialized velocity dexp_{-xi}(xi_dot) of the curve q0 exp(xi(t)) with
-  //             xi' = xi_dot, n jets in the 2n variables (xi, xi_dot).
-  // Either output may be null. On R^n: q0 + eta + xi and xi_dot. Needs 2n <= kMaxJetVariables.
-  virtual Status chart_jets(const double* /*q0*/, const double* /*xi*/, const double* /*xi_dot*/,
-                            Jet2* /*point*/, Jet2* /*velocity*/) noexcept {
-    return "this manifold does not provide its natural chart at jets";
+  //             xi' = xi_dot, n components in the 2n variables (xi, xi_dot).
+  // On R^n: q0 + eta + xi and xi_dot.
+  virtual Status chart(const double* /*q0*/, const double* /*xi*/, const double* /*xi_dot*/,
+                       Derivatives /*point*/, Derivatives /*velocity*/) noexcept {
+    return "this manifold does not provide its natural chart to second order";
   }
-  // The chart's inverse at jets, for the shooting construction's boundary condition (paper,
-  // sec. 3 with sec. 2 "Natural charts"): xi = local(q0, q) = log(q0^{-1} q) (dim() jets) of a
-  // point q given as point_size() jets; q0 is a constant. On R^n: q - q0.
-  virtual Status local_jets(const double* /*q0*/, const Jet2* /*q*/, Jet2* /*xi*/) noexcept {
-    return "this manifold does not provide its natural chart's inverse at jets";
+  // The chart's inverse to second order, for the shooting construction's boundary condition
+  // (paper, sec. 3 with sec. 2 "Natural charts"): xi = local(q0, q) = log(q0^{-1} q), dim()
+  // components in the point_size() variables q. On R^n: q - q0.
+  virtual Status local_derivatives(const double* /*q0*/, const double* /*q*/, Derivatives /*xi*/) noexcept {
+    return "this manifold does not provide its natural chart's inverse to second order";
   }
 };
 

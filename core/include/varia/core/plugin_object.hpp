@@ -12,8 +12,9 @@ namespace varia {
 
 // Bumped whenever a virtual interface below or in the kind headers changes layout.
 // 2: Lagrangian::gradient_jet, OneStepMethod; 3: Manifold::constraint_error; 4: VectorField's
-// Lie group hooks (algebra, move); 5: Manifold::chart_jets, Manifold::local_jets;
-// 6: Lagrangian::evaluates_at_jets, PluginObject::origin.
+// Lie group hooks (algebra, move); 5: Manifold::chart_jets, Manifold::local_jets; 6: the chart's
+// derivatives as caller-sized arrays (Manifold::chart, Manifold::local_derivatives, replacing the
+// jets), Manifold::has_constraint, Lagrangian::evaluates_at_jets, PluginObject::origin.
 inline constexpr int kAbiVersion = 6;
 
 using Status = const char*;

@@ -45,10 +45,10 @@
 //
 // On a Lie group (a manifold that is not a vector space; SO(3)-shaped, rotation_field.hpp) the same
 // construction runs in the natural charts (paper, sec. 2 "Natural charts", sec. 3): the jet
-// variables are x = (eta, w0) with q^0 = q0 exp(eta) at eta = 0 (Manifold::chart_jets), the state
+// variables are x = (eta, w0) with q^0 = q0 exp(eta) at eta = 0 (Manifold::chart), the state
 // (R, Omega) propagated by the method with the Euler-Lagrange field on TSO(3) (a Lie group method
 // moves R exp(.)), S = h sum_i b_i L(R^i, Omega^i), and the boundary quantity B = local(q1, R^n)
-// = log(q1^{-1} R^n) (Manifold::local_jets), centred at R^n's value in a step. Then G_eta - B_eta^T
+// = log(q1^{-1} R^n) (Manifold::local_derivatives), centred at R^n's value in a step. Then G_eta - B_eta^T
 // lambda is D1 L_d and lambda = dG/dB at B = 0 is D2 L_d, both left-trivialized: the discrete
 // momenta are body momenta, as lie-verlet's. The lagrangian form only, no forces, no end-derivative
 // quadratures there.
@@ -144,6 +144,9 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // Workspace, sized once: a step allocates nothing.
   std::vector<Jet2> state_, next_, v_, acceleration_, gradient_, boundary_, force_;
   Jet2 generating_;
+  // The natural chart's derivatives (Manifold::chart, local_derivatives), component-major.
+  std::vector<double> end_, chart_value_, chart_gradient_, chart_hessian_, local_value_, local_gradient_,
+      local_hessian_;
   Eigen::VectorXd w_, lambda_, D1_, residual_, update_;
   Eigen::VectorXd alpha_;        // G_x + W_x: the forced 1-form in x = (q0, w0)
   Eigen::MatrixXd work_jacobian_;  // dW_x/dx

@@ -258,7 +258,7 @@ inline Jet2 jet6(double value) {
   return jet;
 }
 
-// The natural chart at R0 to second order (Manifold::chart_jets; paper, sec. 2 "Natural charts"):
+// The natural chart at R0 to second order (the SO3 manifold's chart; paper, sec. 2 "Natural charts"):
 // R0 exp(eta) exp(xi) at eta = 0 as 9 row-major jets in the variables (eta, xi), and the
 // left-trivialized velocity dexp_{-xi}(xi_dot) as 3 jets in (xi, xi_dot). Either output may be
 // null.
@@ -321,7 +321,7 @@ inline void chart_jets(const double* R0, const double* xi, const double* xi_dot,
   }
 }
 
-// The natural chart's inverse (Manifold::local, and local_jets with T a jet): xi = log(R0^{-1} R)
+// The natural chart's inverse (Manifold::local, and at jets with T a jet): xi = log(R0^{-1} R)
 // for R given as 9 row-major numbers. R0^{-1} rather than R0^T: the same for a rotation, but for
 // a point that carries round-off it keeps local the exact inverse of retract (R0 exp(xi)), which
 // the shooting construction's boundary condition needs (with R0^T the discrete momentum drifted

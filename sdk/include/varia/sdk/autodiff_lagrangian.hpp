@@ -21,9 +21,19 @@
 
 namespace varia::sdk {
 
-inline constexpr int kMaxAutodiffVariables = 16;  // m + n of an autodiff Lagrangian
+inline constexpr int kMaxAutodiffVariables = 18;  // m + n of an autodiff Lagrangian (SE(3): 12 + 6)
+// First derivatives at jet inputs (Lagrangian::gradient_jet): at most kMaxJetInputs numbers
+// m + n (SO(3): 9 + 3), which keeps a Vec of these scalars (12 x 7.9 kB) within Eigen's stack
+// allocation limit (128 kB): a Vec of dual numbers over jets has that capacity, any other Vec
+// kMaxAutodiffVariables.
+inline constexpr int kMaxJetInputs = 12;
 template <class T>
-using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, kMaxAutodiffVariables, 1>;
+inline constexpr int vec_capacity = kMaxAutodiffVariables;
+template <class D>
+inline constexpr int vec_capacity<Eigen::AutoDiffScalar<D>> =
+    std::is_same_v<typename D::Scalar, Jet2> ? kMaxJetInputs : kMaxAutodiffVariables;
+template <class T>
+using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, vec_capacity<T>, 1>;
 using Dual = Eigen::AutoDiffScalar<Vec<double>>;
 using Dual2 = Eigen::AutoDiffScalar<Vec<Dual>>;
 // The fixed-size counterparts for m + n = K (Eigen's AutoDiffScalar takes any derivative vector).
@@ -31,10 +41,6 @@ template <int K>
 using FixedDual = Eigen::AutoDiffScalar<Eigen::Matrix<double, K, 1>>;
 template <int K>
 using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
-// First derivatives at jet inputs (Lagrangian::gradient_jet): at most kMaxJetInputs numbers
-// m + n (SO(3): 9 + 3), which keeps a Vec of these scalars (16 x 7.9 kB) within Eigen's stack
-// allocation limit (128 kB).
-inline constexpr int kMaxJetInputs = 12;
 using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, Eigen::Dynamic, 1, 0, kMaxJetInputs, 1>>;
 // Its fixed-size counterpart for m + n = K: K jets per derivative vector, not the capacity's 12.
 template <int K>

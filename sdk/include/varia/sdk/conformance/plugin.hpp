@@ -18,11 +18,12 @@
 
 namespace varia::sdk::conformance {
 
-// The contexts a Lagrangian plugin may accept: Rn with dim 1 to 8, and SO3.
+// The contexts a Lagrangian plugin may accept: Rn with dim 1 to 8, SO3 and SE3.
 inline std::vector<nlohmann::json> lagrangian_contexts() {
   std::vector<nlohmann::json> contexts;
   for (int n = 1; n <= 8; ++n) contexts.push_back({{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
   contexts.push_back({{"manifold", "SO3"}, {"point_size", 9}, {"dim", 3}});
+  contexts.push_back({{"manifold", "SE3"}, {"point_size", 12}, {"dim", 6}});
   return contexts;
 }
 
