@@ -53,7 +53,7 @@ struct Exact {
 
 Exact exact_at(Assembly& pendulum, double t) {
   double q0 = kQ0, v0 = 0.0, q = 0.0, v = 0.0;
-  varia::check(pendulum.lagrangian->exact_solution(&q0, &v0, t, &q, &v), "exact solution");
+  varia::check(*pendulum.lagrangian, pendulum.lagrangian->exact_solution(&q0, &v0, t, &q, &v), "exact solution");
   return {q, v};
 }
 

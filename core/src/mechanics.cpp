@@ -24,7 +24,7 @@ LagrangianEvaluator::LagrangianEvaluator(Lagrangian& lagrangian)
 
 // Out of line, so that the inline check that runs on every evaluation is a loop of scalar loads
 // and well-predicted branches.
-void LagrangianEvaluator::not_finite(const char* what) {
+void LagrangianEvaluator::not_finite(const char* what) const {
   throw NumericalFailure(std::string("the Lagrangian's ") + what + " is not finite", std::nan(""),
                          lagrangian_.origin());
 }

@@ -127,12 +127,12 @@ TEST_CASE("an object a plugin made outlives the registry (it holds its library)"
   CHECK(manifold->dim() == 3);
 }
 
-TEST_CASE("a plugin that refuses its parameters is a load error naming the file and the type") {
+TEST_CASE("a plugin that refuses a parameter value is bad input naming the plugin, its type and why") {
   Registry registry(Registry::search_path({}));
-  const std::string message = error_of<PluginLoadError>(
+  const std::string message = error_of<InputError>(
       [&] { registry.create("manifold", "Rn", {{"dim", "three"}}, sdk::Context{"Rn", 0, 0}); });
   CAPTURE(message);
-  CHECK(contains(message, "manifold_Rn.so: Rn: "));
+  CHECK(message == "Rn: 'dim' must be an integer >= 1, got \"three\" (the Rn plugin manifold_Rn.so)");
 }
 
 }  // namespace

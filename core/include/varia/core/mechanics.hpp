@@ -56,7 +56,7 @@ class LagrangianEvaluator {
     for (int i = 0; i < count; ++i)
       if (!std::isfinite(values[i])) not_finite(what);
   }
-  [[noreturn]] static void not_finite(const char* what);
+  [[noreturn]] void not_finite(const char* what) const;
   // The gradient, and L where value is not null.
   void evaluate_gradient(const double* q, const double* v, double* value, double* gradient) {
     check(lagrangian_, lagrangian_.evaluate(q, v, value, gradient, nullptr), "Lagrangian gradient");

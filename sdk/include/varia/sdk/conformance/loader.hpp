@@ -4,6 +4,7 @@
 #pragma once
 
 #include <boost/dll/shared_library.hpp>
+#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -38,14 +39,17 @@ class LoadedPlugin {
   nlohmann::json parameter_schema() const { return nlohmann::json::parse(info_->parameter_schema); }
 
   // An object of the plugin's kind T made from `parameters` in `context`; throws
-  // std::runtime_error with the plugin's message when it refuses them.
+  // std::runtime_error with the plugin's message when it refuses them (without the factory's
+  // kRefusedParameter mark of a refused value).
   template <class T>
   std::shared_ptr<T> create(const nlohmann::json& parameters,
                             const nlohmann::json& context = {{"manifold", "Rn"}, {"point_size", 1}, {"dim", 1}}) const {
     char error[512] = "";
     auto& factory = library_->get_alias<CreateFunction>("varia_create");
     PluginObject* object = factory(parameters.dump().c_str(), context.dump().c_str(), error, sizeof error);
-    if (object == nullptr) throw std::runtime_error(error);
+    const std::size_t marker = std::strlen(kRefusedParameter);
+    if (object == nullptr)
+      throw std::runtime_error(std::strncmp(error, kRefusedParameter, marker) == 0 ? error + marker : error);
     // Made by the plugin, so typeid and dynamic_cast across the boundary are not to be trusted:
     // the object is T because the plugin's kind says so.
     auto library = library_;
