@@ -12,6 +12,7 @@
 #include <cmath>
 
 #include "varia/core/so3.hpp"
+#include "varia/sdk/groups/so3.hpp"
 #include "varia/sdk/lie_group.hpp"
 #include "varia/sdk/no_parameters.hpp"
 #include "varia/sdk/plugin.hpp"
@@ -20,11 +21,7 @@ namespace {
 
 namespace so3 = varia::so3;
 
-// A point is accepted when ||I - R^T R||_F and |det R - 1| are below this.
-constexpr double kMembershipTolerance = 1e-9;
-
-template <class T>
-using RowMajor = Eigen::Matrix<T, 3, 3, Eigen::RowMajor>;
+using varia::sdk::groups::RowMajor;
 
 // The minimal API of SE(3) (varia/sdk/lie_group.hpp).
 struct RigidMotions {
@@ -79,18 +76,9 @@ class SE3 final : public varia::sdk::LieGroupManifold<RigidMotions> {
   }
 
   bool contains(const double* q, char* why, int why_size) noexcept override {
-    using varia::sdk::explain;
-    for (int i = 0; i < 12; ++i)
-      if (!std::isfinite(q[i]))
-        return explain(why, why_size, "entry %d of the point (R, x) is not finite", i);
-    const Eigen::Matrix3d R = so3::from_row_major(q);
-    const double orthogonality = so3::orthogonality_error(R);
-    if (orthogonality > kMembershipTolerance)
-      return explain(why, why_size, "R is not orthogonal: ||I - R^T R|| = %.3g (tolerance %g)",
-                     orthogonality, kMembershipTolerance);
-    if (std::abs(R.determinant() - 1.0) > kMembershipTolerance)
-      return explain(why, why_size, "R is a reflection, not a rotation: det R = %.17g", R.determinant());
-    return true;
+    for (int i = 9; i < 12; ++i)
+      if (!std::isfinite(q[i])) return varia::sdk::explain(why, why_size, "entry %d of the position x is not finite", i - 9);
+    return varia::sdk::groups::contains_rotation(q, why, why_size);
   }
 
   bool has_constraint() const noexcept override { return true; }

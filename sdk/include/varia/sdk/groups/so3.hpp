@@ -22,6 +22,21 @@ constexpr double kMembershipTolerance = 1e-9;
 template <class T>
 using RowMajor = Eigen::Matrix<T, 3, 3, Eigen::RowMajor>;
 
+// Whether the 9 numbers R (row-major) are a rotation, to kMembershipTolerance; fills `why` when
+// not. The check of SO(3)'s points and of the rotation part of SE(3)'s.
+inline bool contains_rotation(const double* q, char* why, int why_size) {
+  for (int i = 0; i < 9; ++i)
+    if (!std::isfinite(q[i])) return explain(why, why_size, "entry %d of R is not finite", i);
+  const Eigen::Matrix3d R = from_row_major(q);
+  const double orthogonality = so3::orthogonality_error(R);
+  if (orthogonality > kMembershipTolerance)
+    return explain(why, why_size, "R is not orthogonal: ||I - R^T R|| = %.3g (tolerance %g)", orthogonality,
+                   kMembershipTolerance);
+  if (std::abs(R.determinant() - 1.0) > kMembershipTolerance)
+    return explain(why, why_size, "R is a reflection, not a rotation: det R = %.17g", R.determinant());
+  return true;
+}
+
 // The minimal API of SO(3) (varia/sdk/lie_group.hpp): R row-major, the algebra R^3 with the
 // cross product as bracket.
 struct Rotations {
@@ -78,17 +93,7 @@ class RotationGroup : public LieGroupManifold<Rotations> {
   }
 
   bool contains(const double* q, char* why, int why_size) noexcept override {
-    for (int i = 0; i < 9; ++i)
-      if (!std::isfinite(q[i])) return explain(why, why_size, "entry %d of R is not finite", i);
-    const Eigen::Matrix3d R = from_row_major(q);
-    const double orthogonality = so3::orthogonality_error(R);
-    if (orthogonality > kMembershipTolerance)
-      return explain(why, why_size, "R is not orthogonal: ||I - R^T R|| = %.3g (tolerance %g)",
-                     orthogonality, kMembershipTolerance);
-    if (std::abs(R.determinant() - 1.0) > kMembershipTolerance)
-      return explain(why, why_size, "R is a reflection, not a rotation: det R = %.17g",
-                     R.determinant());
-    return true;
+    return contains_rotation(q, why, why_size);
   }
 
   bool has_constraint() const noexcept override { return true; }
