@@ -309,7 +309,7 @@ MomentumError conserved_momentum(const json& document, int components, double bo
   const Ran ran = run_scene(document);
   check_clean_success(ran);
   const MomentumError e = momentum_error(ran.csv, components);
-  MESSAGE(what, ": steps ", ran.record["steps"].get<long>(), ", max |mu - mu0|/|mu0| ", e.max, " (first quarter ",
+  MESSAGE(std::string(what), ": steps ", ran.record["steps"].get<long>(), ", max |mu - mu0|/|mu0| ", e.max, " (first quarter ",
           e.first_quarter, ", last ", e.last_quarter, "), Newton mean ", ran.record["newton_iterations"]["mean"].get<double>(),
           ", wall ", ran.record["wall_seconds"].get<double>(), " s");
   CHECK(e.max <= bound);
