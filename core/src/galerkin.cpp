@@ -85,6 +85,7 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
       weights_(Eigen::Map<const Eigen::VectorXd>(quadrature.weights(), quadrature.size())),
       nodes_(Eigen::Map<const Eigen::VectorXd>(quadrature.nodes(), quadrature.size())),
       options_(options),
+      solver_(options),
       n_(manifold.dim()),
       s_(static_cast<int>(control_times.size()) - 1) {
   if (!manifold.is_vector_space())
@@ -110,11 +111,8 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   velocity_ = Eigen::VectorXd::Zero(n_);
   grad_.resize(2 * n_);
   gradient_.resize((s_ + 1) * n_);
-  residual_.resize(s_ * n_);
-  update_.resize(s_ * n_);
   f_.resize(n_);
   force_values_.resize(static_cast<Eigen::Index>(forces_.rows().size()));
-  residuals_.reserve(options_.max_iterations + 1);
   if (lagrangian_.sparse()) {
     sparse_values_.resize(lagrangian_.pattern_size());
     for (int e = 0; e < lagrangian_.pattern_size(); ++e) {
@@ -125,8 +123,7 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
     hess_.resize(2 * n_, 2 * n_);
     column_.resize(2 * n_);
     hessian_.resize((s_ + 1) * n_, (s_ + 1) * n_);
-    jacobian_.resize(s_ * n_, s_ * n_);
-    lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(s_ * n_);
+    dense_ = DenseLinearization(s_ * n_);
   }
   // The forces' Jacobian [df/dq, df/dv]: rows are equations (weighted by l_nu, never by v).
   for (std::size_t e = 0; e < forces_.rows().size(); ++e)
@@ -429,94 +426,82 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
   sparse_.analyzed = false;
 }
 
-void GalerkinDiscreteLagrangian::solve_dense(int first_unknown, int first_equation, int blocks, bool refactor) {
-  const int size = blocks * n_;
-  auto residual = residual_.head(size);
-  auto update = update_.head(size);
-  if (size == jacobian_.rows()) {
-    if (refactor) {
-      jacobian_ = hessian_.block(first_equation * n_, first_unknown * n_, size, size);
-      lu_.compute(jacobian_);
+// The equations dS/dq^nu (+ f_d^nu when forced) = 0, nu in [first_equation, first_equation +
+// blocks), in the control points [first_unknown, first_unknown + blocks), with p0 (if not null)
+// added to the equation nu = 0 (IDEL: p0 + D1 L_d + f_d^0 = 0), as a system for NewtonSolver
+// (solve/newton.hpp), with the exact Jacobian.
+struct GalerkinDiscreteLagrangian::Equations {
+  GalerkinDiscreteLagrangian& g;
+  double h;
+  int first_unknown, first_equation, blocks;
+  const double* p0;
+  bool forced;
+
+  int size() const { return blocks * g.n_; }
+  // F's round-off yardstick: the largest of its terms p0 and dS/dq^nu.
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
+    g.action(h, Order::hessian, forced);
+    F = g.gradient_.segment(first_equation * g.n_, size());
+    double yardstick = g.gradient_.lpNorm<Eigen::Infinity>();
+    if (p0 != nullptr) {
+      const Eigen::Map<const Eigen::VectorXd> momentum(p0, g.n_);
+      F.head(g.n_) += momentum;
+      yardstick = std::max(yardstick, momentum.lpNorm<Eigen::Infinity>());
     }
-    update.noalias() = lu_.solve(residual);
-  } else {
-    update = hessian_.block(first_equation * n_, first_unknown * n_, size, size).partialPivLu().solve(residual);
+    return yardstick;
   }
-}
+  void factorize() {
+    if (g.lagrangian_.sparse()) return g.factorize_sparse();
+    g.dense_.jacobian = g.hessian_.block(first_equation * g.n_, first_unknown * g.n_, size(), size());
+    g.dense_.factorize();
+  }
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) {
+    if (g.lagrangian_.sparse()) update = g.sparse_.lu.solve(F);
+    else g.dense_.solve(F, update);
+  }
+  // x's round-off yardstick: the control points' size, q^0 + offsets.
+  double apply(const Eigen::VectorXd& update) {
+    g.points_.middleCols(first_unknown, blocks).reshaped() -= update;
+    return g.origin_.lpNorm<Eigen::Infinity>() + g.points_.lpNorm<Eigen::Infinity>();
+  }
+  void finish(const Eigen::VectorXd& update) { g.gradient_after_update(h, first_unknown, update, forced); }
+};
 
 // Eigen's SparseLU: the symbolic analysis (COLAMD ordering) once per structure, the numerical
-// factorization per Newton iteration.
-void GalerkinDiscreteLagrangian::solve_sparse(bool refactor) {
+// factorization when the solver asks for it.
+void GalerkinDiscreteLagrangian::factorize_sparse() {
   if (!sparse_.analyzed) {
     sparse_.lu.analyzePattern(sparse_.matrix);
     sparse_.analyzed = true;
-    refactor = true;
   }
-  if (refactor) sparse_.lu.factorize(sparse_.matrix);
+  sparse_.lu.factorize(sparse_.matrix);
   if (sparse_.lu.info() != Eigen::Success)
     throw NumericalFailure("the Galerkin Newton Jacobian is singular: " + sparse_.lu.lastErrorMessage(),
                            std::nan(""));
-  const Eigen::Index size = sparse_.matrix.rows();
-  update_.head(size) = sparse_.lu.solve(residual_.head(size));
 }
 
-// Newton's method with the exact Jacobian. The residual that passes the test is still used for
-// one more update (its Jacobian is at hand; no evaluation is needed, see gradient_after_update):
-// a residual left at the tolerance, e.g. by a warm start that passes the test at once, has the
-// same sign from step to step and adds up over a run (bench/README.md), where the update takes it
-// to round-off. That last update, after an iteration, reuses the last iteration's factorization
-// (the Jacobians differ by O(last update), so the update's error is O(last update x this update),
-// far below round-off). A solve also ends when an update is below tolerance relative to the
-// offsets q^nu - q^0. The iterations counted are the updates taken.
+// Newton's method with the exact Jacobian (solve/newton.hpp: its stopping rule, and the update
+// from the last residual always applied).
 void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
                                         int blocks, const double* p0, bool forced) {
+  if (lagrangian_.sparse()) prepare_sparse(first_unknown, first_equation, blocks);
   const int size = blocks * n_;
-  const bool sparse = lagrangian_.sparse();
-  if (sparse) prepare_sparse(first_unknown, first_equation, blocks);
-  residuals_.clear();
-  auto residual = residual_.head(size);
-  auto update = update_.head(size);
-  for (int iteration = 0;; ++iteration) {
-    action(h, Order::hessian, forced);
-    residual = gradient_.segment(first_equation * n_, size);
-    double scale = gradient_.lpNorm<Eigen::Infinity>();
-    if (p0 != nullptr) {
-      const Eigen::Map<const Eigen::VectorXd> momentum(p0, n_);
-      residual.head(n_) += momentum;
-      scale = std::max(scale, momentum.lpNorm<Eigen::Infinity>());
-    }
-    const double norm = residual.lpNorm<Eigen::Infinity>();
-    residuals_.push_back(norm);
-    if (!std::isfinite(norm))
-      throw NumericalFailure("the Galerkin equations have a non-finite residual", norm);
-    const bool converged = options_.converged(norm, scale);
-    if (!converged && iteration == options_.max_iterations)
-      throw NumericalFailure("Newton's method did not converge in " +
-                                 std::to_string(options_.max_iterations) + " iterations",
-                             norm);
-    const bool refactor = !(converged && iteration > 0);
-    if (sparse)
-      solve_sparse(refactor);
-    else
-      solve_dense(first_unknown, first_equation, blocks, refactor);
-    points_.middleCols(first_unknown, blocks).reshaped() -= update;
-    if (converged || options_.converged(update.lpNorm<Eigen::Infinity>(), points_.lpNorm<Eigen::Infinity>())) {
-      gradient_after_update(h, first_unknown, size, forced);
-      return statistics_.record(iteration + 1);
-    }
-  }
+  if (!lagrangian_.sparse() && dense_.jacobian.rows() != size) dense_ = DenseLinearization(size);
+  Equations equations{*this, h, first_unknown, first_equation, blocks, p0, forced};
+  require_converged(solver_.solve(equations, statistics_), "the Galerkin equations");
 }
 
 // The gradient (and impulse_) at the points just updated. Dense: from the Hessian at hand, to
-// first order in the update (dS/dq^nu -= sum_mu d2S/dq^nu dq^mu update^mu); the update is at the
-// tolerance here, so the neglected O(|update|^2) term is far below round-off and no evaluation is
-// made. Sparse: the Jacobian holds only the equations' rows, so the gradient is evaluated again.
-void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unknown, int size, bool forced) {
+// first order in the update (dS/dq^nu -= sum_mu d2S/dq^nu dq^mu update^mu); the update is at
+// round-off here, so the neglected O(|update|^2) term is far below it and no evaluation is made.
+// Sparse: the Jacobian holds only the equations' rows, so the gradient is evaluated again.
+void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unknown,
+                                                       const Eigen::VectorXd& update, bool forced) {
   if (lagrangian_.sparse()) {
     action(h, Order::gradient, forced);
     return;
   }
-  change_.noalias() = hessian_.middleCols(first_unknown * n_, size) * update_.head(size);
+  change_.noalias() = hessian_.middleCols(first_unknown * n_, update.size()) * update;
   gradient_ -= change_;
   for (int nu = 0; nu <= s_; ++nu) impulse_ -= change_.segment(nu * n_, n_);
 }

@@ -1,9 +1,12 @@
 #include "varia/core/galerkin_chart.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
+
+#include "varia/core/compensated.hpp"
 
 namespace varia {
 
@@ -15,7 +18,27 @@ bool invariant_under_the_whole_group(Lagrangian& lagrangian, int dim) {
   return lagrangian.momentum_size() == dim;
 }
 
+constexpr double kEpsilon = 0x1p-52;
+constexpr int kMaxIncrementNodes = 10;
+
 }  // namespace
+
+// The k-node Gauss-Legendre rule on [0, 1] by Golub and Welsch (Math. Comp. 23, 1969): the nodes
+// are the eigenvalues of the Jacobi matrix of the Legendre polynomials, the weights the squared
+// first components of its unit eigenvectors; with its error constant E_k (see point_increment).
+LieGroupGalerkinDiscreteLagrangian::GaussRule LieGroupGalerkinDiscreteLagrangian::gauss_legendre(int k) {
+  Eigen::MatrixXd jacobi = Eigen::MatrixXd::Zero(k, k);
+  for (int i = 1; i < k; ++i) jacobi(i, i - 1) = jacobi(i - 1, i) = i / std::sqrt(4.0 * i * i - 1.0);
+  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jacobi);
+  GaussRule rule;
+  rule.nodes = (eigen.eigenvalues().array() + 1.0) / 2.0;
+  rule.weights = eigen.eigenvectors().row(0).transpose().array().square();
+  double factorial = 1.0, double_factorial = 1.0;  // k!, (2k)!
+  for (int i = 1; i <= k; ++i) factorial *= i;
+  for (int i = 1; i <= 2 * k; ++i) double_factorial *= i;
+  rule.bound = std::pow(factorial, 4) / ((2 * k + 1) * std::pow(double_factorial, 3));
+  return rule;
+}
 
 LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
     Manifold& manifold, Lagrangian& lagrangian, Quadrature& quadrature,
@@ -25,6 +48,7 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
       basis_(control_times, quadrature),
       weights_(Eigen::Map<const Eigen::VectorXd>(quadrature.weights(), quadrature.size())),
       options_(options),
+      solver_(options),
       reduced_(reduced),
       m_(manifold.point_size()),
       n_(manifold.dim()),
@@ -69,10 +93,14 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
   dexp_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
   lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_ * s_);
   residual_.resize(n_ * s_);
-  update_.resize(n_ * s_);
   momentum_.resize(n_);
   jacobian_.resize(n_ * s_, n_ * s_);
-  residuals_.reserve(options_.max_iterations + 1);
+  carry_g_ = Eigen::VectorXd::Zero(m_);
+  carry_p_ = Eigen::VectorXd::Zero(n_);
+  last_p_.resize(n_);
+  point_change_.resize(m_);
+  momentum_change_.resize(n_);
+  for (int k = 1; k <= kMaxIncrementNodes; ++k) increment_rules_.push_back(gauss_legendre(k));
 }
 
 void LieGroupGalerkinDiscreteLagrangian::check(Status status) const {
@@ -187,47 +215,44 @@ void LieGroupGalerkinDiscreteLagrangian::step_equations(const double* p0) {
         dexp_inverse_T_ * (dexp_derivative_[l].transpose() * momentum_);
 }
 
-void LieGroupGalerkinDiscreteLagrangian::newton(const double* q0, const double* p0, double h) {
-  const int size = unknowns_ * n_;
-  residuals_.clear();
-  auto residual = residual_.head(size);
-  auto update = update_.head(size);
-  auto jacobian = jacobian_.topLeftCorner(size, size);
-  double previous_update = 0.0;
-  for (int iteration = 0;; ++iteration) {
-    action(q0, h);
-    if (p0 != nullptr) dexp_with_derivatives(q0, xi_.col(s_).data(), 1.0);
-    step_equations(p0);
-    double scale = gradient_.lpNorm<Eigen::Infinity>();
-    if (p0 != nullptr) scale = std::max(scale, Eigen::Map<const Eigen::VectorXd>(p0, n_).lpNorm<Eigen::Infinity>());
-    const double norm = residual.lpNorm<Eigen::Infinity>();
-    residuals_.push_back(norm);
-    if (!std::isfinite(norm))
-      throw NumericalFailure("the Lie group Galerkin equations have a non-finite residual", norm);
-    // At least one update is taken: a warm start that passes the residual test still carries a
-    // residual of the order of the tolerance, always of one sign along a trajectory.
-    if (iteration > 0 && options_.converged(norm, scale)) return statistics_.record(iteration);
-    if (iteration == options_.max_iterations)
-      throw NumericalFailure("Newton's method did not converge in " +
-                                 std::to_string(options_.max_iterations) + " iterations",
-                             norm);
-    lu_.compute(jacobian);
-    update = lu_.solve(residual);
-    xi_.middleCols(1, unknowns_).reshaped() -= update;
-    // Converged when the update, or the error left after it, is below the tolerance. With the
-    // contraction theta = |update_k| / |update_{k-1}| the error left is about
-    // theta / (1 - theta) |update_k| (Hairer & Wanner, Solving ODEs II, sec. IV.8); Newton's
-    // quadratic convergence makes it tiny after an update of 1e-9, saving the Hessians of an
-    // iteration that would only confirm it.
-    const double size_of_update = update.lpNorm<Eigen::Infinity>();
-    const double theta = previous_update > 0.0 ? size_of_update / previous_update : 1.0;
-    const double left = theta < 1.0 ? std::min(1.0, theta / (1.0 - theta)) * size_of_update : size_of_update;
-    previous_update = size_of_update;
-    if (options_.converged(left, xi_.lpNorm<Eigen::Infinity>())) {
-      action(q0, h, false);
-      return statistics_.record(iteration + 1);
-    }
+// The step's equations [p0 + D1 L_d; dS/dxi^1..s-1] (evaluate: the internal ones) in the control
+// points xi^1..xi^unknowns, as a system for NewtonSolver (solve/newton.hpp), with the exact
+// Jacobian.
+struct LieGroupGalerkinDiscreteLagrangian::Equations {
+  LieGroupGalerkinDiscreteLagrangian& g;
+  const double* q0;
+  const double* p0;
+  double h;
+
+  int size() const { return g.unknowns_ * g.n_; }
+  // F's round-off yardstick: the largest of its terms p0 and dS/d(eta, xi).
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
+    g.action(q0, h);
+    if (p0 != nullptr) g.dexp_with_derivatives(q0, g.xi_.col(g.s_).data(), 1.0);
+    g.step_equations(p0);
+    F = g.residual_.head(size());
+    double yardstick = g.gradient_.lpNorm<Eigen::Infinity>();
+    if (p0 != nullptr) yardstick = std::max(yardstick, Eigen::Map<const Eigen::VectorXd>(p0, g.n_).lpNorm<Eigen::Infinity>());
+    return yardstick;
   }
+  void factorize() { g.lu_.compute(g.jacobian_.topLeftCorner(size(), size())); }
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { update.noalias() = g.lu_.solve(F); }
+  // x's round-off yardstick: the size of the points g0 exp(xi) stand for, g0's and the chart's.
+  double apply(const Eigen::VectorXd& update) {
+    g.xi_.middleCols(1, g.unknowns_).reshaped() -= update;
+    return Eigen::Map<const Eigen::VectorXd>(q0, g.m_).lpNorm<Eigen::Infinity>() + g.xi_.lpNorm<Eigen::Infinity>();
+  }
+  // The gradient at the updated points, to first order from the Hessian at hand (the update is
+  // at round-off: the O(|update|^2) term is far below it), and the residual left, F - J update.
+  void finish(const Eigen::VectorXd& update) {
+    g.gradient_.noalias() -= g.hessian_.middleCols(g.n_, size()) * update;
+    g.residual_.head(size()).noalias() -= g.jacobian_.topLeftCorner(size(), size()) * update;
+  }
+};
+
+void LieGroupGalerkinDiscreteLagrangian::newton(const double* q0, const double* p0, double h) {
+  Equations equations{*this, q0, p0, h};
+  require_converged(solver_.solve(equations, statistics_), "the Lie group Galerkin equations");
 }
 
 // The initial guess: the previous step's curve continued past its end (mapped into this step's
@@ -248,19 +273,82 @@ void LieGroupGalerkinDiscreteLagrangian::warm_start(const double* q0, const doub
   xi_.col(0).setZero();
 }
 
+// g1 = g0 exp(xi^s) and p1 = D2 L_d, each written as its start plus a small increment summed with
+// Kahan's compensation across steps (compensated.hpp) while each step continues from the last
+// one's output, so that a conserved momentum stays at round-off over long runs:
+//   g1 - g0 by point_increment();
+//   p1 - p0 = (D1 L_d + D2 L_d) - (p0 + D1 L_d) = tau + (dexp_{-xi}^{-T} - dexp_{xi}^{-T}) sigma - r0
+//           = tau + A(xi)^T sigma - r0,
+// r0 the residual left in the first equation. A(xi) = dexp_{-xi}^{-1} - dexp_{xi}^{-1} is linear in
+// xi, twice the derivative of dexp at 0 (the series dexp_{xi}^{-1} = sum_k B_k/k! ad_xi^k has
+// B_1 = -1/2 and no other odd term): every term is of the size of the step's change, and is
+// computed to its own relative precision.
 void LieGroupGalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, double /*t0*/, double h,
                                                    double* q1, double* p1) {
+  const Eigen::Map<const Eigen::VectorXd> start(q0, m_), momentum(p0, n_);
+  if (!(has_previous_ && last_end_ == start && last_p_ == momentum)) {
+    carry_g_.setZero();
+    carry_p_.setZero();
+  }
   warm_start(q0, p0, h);
   unknowns_ = s_;
   newton(q0, p0, h);
-  check(manifold_.retract(q0, xi_.col(s_).data(), q1));
-  dexp_with_derivatives(q0, xi_.col(s_).data(), -1.0);  // dexp_{-xi^s}: p1 = D2 L_d
-  Eigen::Map<Eigen::VectorXd>(p1, n_).noalias() = dexp_inverse_T_ * gradient_.segment(s_ * n_, n_);
+  if (dexp_slopes_.empty()) dexp_slopes(q0);
+  const auto xi = xi_.col(s_);
+  const auto sigma = gradient_.segment(s_ * n_, n_);
+  momentum_change_ = gradient_.head(n_) - residual_.head(n_);
+  for (int l = 0; l < n_; ++l) momentum_change_.noalias() += (2.0 * xi(l)) * (dexp_slopes_[l].transpose() * sigma);
+  const bool increment = point_increment(q0, xi);
+  last_p_ = momentum;
+  compensated_add(last_p_, momentum_change_, carry_p_);
+  if (increment) {
+    last_end_ = start;
+    compensated_add(last_end_, point_change_, carry_g_);
+  } else {
+    check(manifold_.retract(q0, xi.data(), last_end_.data()));
+    carry_g_.setZero();
+  }
+  Eigen::Map<Eigen::VectorXd>(q1, m_) = last_end_;
+  Eigen::Map<Eigen::VectorXd>(p1, n_) = last_p_;
   previous_ = xi_;
-  previous_base_ = Eigen::Map<const Eigen::VectorXd>(q0, m_);
-  last_end_ = Eigen::Map<const Eigen::VectorXd>(q1, m_);
+  previous_base_ = start;
   previous_h_ = h;
   has_previous_ = true;
+}
+
+// d dexp_w / dw_l at w = 0 (the Lie algebra's structure: dexp_w = I -/+ ad_w / 2 + O(w^2)).
+void LieGroupGalerkinDiscreteLagrangian::dexp_slopes(const double* q0) {
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
+  dexp_with_derivatives(q0, zero.data(), 1.0);
+  dexp_slopes_ = dexp_derivative_;
+}
+
+// point_change_ = g0 exp(xi) - g0 = int_0^1 d/dt g0 exp(t xi) dt, the integrand the chart's
+// derivative in xi at t xi applied to xi (Manifold::chart), by the Gauss-Legendre rule of
+// fewest nodes k whose error bound E_k |xi|^{2k} relative to |xi| is below eps/8, E_k =
+// (k!)^4 / ((2k + 1) ((2k)!)^3) (Abramowitz & Stegun 25.4.30; the integrand's 2k-th derivative is
+// of size |xi|^{2k+1} on a compact group's chart, and on SE(3)'s translations too). Each node's
+// value carries an error of eps |g0| |xi|: the increment is exact to its own relative precision.
+// False (no increment formed) when |xi|_1 is beyond the largest rule's reach (a step past
+// |xi| ~ 4.8, near the chart's edge).
+bool LieGroupGalerkinDiscreteLagrangian::point_increment(const double* q0, const Eigen::Ref<const Eigen::VectorXd>& xi) {
+  const double size = xi.lpNorm<1>();
+  const GaussRule* rule = nullptr;
+  for (const GaussRule& candidate : increment_rules_)
+    if (candidate.bound * std::pow(size, 2.0 * candidate.nodes.size()) <= 0.125 * kEpsilon) {
+      rule = &candidate;
+      break;
+    }
+  if (rule == nullptr) return false;
+  point_change_.setZero();
+  node_rate_.setZero();
+  for (Eigen::Index i = 0; i < rule->nodes.size(); ++i) {
+    node_xi_ = rule->nodes[i] * xi;
+    check(manifold_.chart(q0, node_xi_.data(), node_rate_.data(), {nullptr, point_gradient_.data(), nullptr}, {}));
+    for (int k = 0; k < m_; ++k)  // the xi block of component k's gradient in (eta, xi)
+      point_change_[k] += rule->weights[i] * Eigen::Map<const Eigen::VectorXd>(&point_gradient_[k * 2 * n_ + n_], n_).dot(xi);
+  }
+  return true;
 }
 
 void LieGroupGalerkinDiscreteLagrangian::evaluate(const double* q0, const double* q1, double h,

@@ -30,7 +30,7 @@ std::string too_far(double h_omega) {
 
 LieGroupVelocityVerlet::LieGroupVelocityVerlet(Manifold& manifold, Lagrangian& lagrangian,
                                                LieVerletSolver solver, SolverOptions options)
-    : lagrangian_(lagrangian), solver_(solver), options_(options) {
+    : lagrangian_(lagrangian), solver_(solver), options_(options), newton_(options) {
   if (manifold.point_size() != 9 || manifold.dim() != 3 || manifold.is_vector_space())
     throw std::invalid_argument("the lie-verlet construction needs the manifold SO3");
   if (lagrangian.position_size() != 9 || lagrangian.velocity_size() != 3)
@@ -42,7 +42,6 @@ LieGroupVelocityVerlet::LieGroupVelocityVerlet(Manifold& manifold, Lagrangian& l
         "V(R), with a constant inertia J (constant_mass_matrix)");
   Jd_ = 0.5 * J_.trace() * Eigen::Matrix3d::Identity() - J_;  // J = tr(J_d) I - J_d
   reference_determinant_ = (solver_ == LieVerletSolver::cayley ? -2.0 : 1.0) * J_.determinant();
-  residuals_.reserve(options_.max_iterations + 1);
 }
 
 double LieGroupVelocityVerlet::trace_product(const Eigen::Matrix3d& D) const {
@@ -81,35 +80,47 @@ void LieGroupVelocityVerlet::residual(const Eigen::Vector3d& f, const Eigen::Vec
   jacobian = K * so3::dexp(Eigen::Vector3d(-f));
 }
 
+// The equation for f as a system for NewtonSolver (solve/newton.hpp), with the exact Jacobian.
+struct LieGroupVelocityVerlet::Equation {
+  LieGroupVelocityVerlet& lgvi;
+  const Eigen::Vector3d& g;
+  Eigen::Matrix3d jacobian, D;
+  Eigen::PartialPivLU<Eigen::Matrix3d> lu;
+
+  int size() const { return 3; }
+  // F's round-off yardstick: g, of the size of its terms (g and 2 J f, or F J_d - J_d F^T).
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
+    Eigen::Vector3d r;
+    lgvi.residual(lgvi.f_, g, r, jacobian, D);
+    F = r;
+    return g.lpNorm<Eigen::Infinity>();
+  }
+  void factorize() { lu.compute(jacobian); }
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { update = lu.solve(Eigen::Vector3d(F)); }
+  double apply(const Eigen::VectorXd& update) {
+    lgvi.f_ -= update;
+    return lgvi.f_.lpNorm<Eigen::Infinity>();
+  }
+  // F - I at the updated f (no plugin call).
+  void finish(const Eigen::VectorXd&) {
+    D = lgvi.solver_ == LieVerletSolver::cayley ? so3::cayley_minus_identity(lgvi.f_) : so3::expm1(lgvi.f_);
+  }
+};
+
 // Newton's method from the previous step's f (or from the linearization f = J^{-1} g, halved for
-// Cayley), until the residual is below tolerance |g| or the update below tolerance |f|. A root
-// whose Jacobian determinant has the other sign than at the identity lies past the fold.
+// Cayley). A root whose Jacobian determinant has the other sign than at the identity lies past
+// the fold.
 Eigen::Matrix3d LieGroupVelocityVerlet::solve(const Eigen::Vector3d& g) {
   const Eigen::Vector3d linear = J_.partialPivLu().solve(g);  // h Omega, to first order
   if (!has_f_) f_ = solver_ == LieVerletSolver::cayley ? Eigen::Vector3d(0.5 * linear) : linear;
-  const double scale = g.lpNorm<Eigen::Infinity>();
-  Eigen::Vector3d r;
-  Eigen::Matrix3d jacobian, D;
-  residuals_.clear();
-  bool small_update = false;
-  for (int iteration = 0;; ++iteration) {
-    residual(f_, g, r, jacobian, D);
-    const double norm = r.lpNorm<Eigen::Infinity>();
-    residuals_.push_back(norm);
-    if (!std::isfinite(norm)) break;
-    if (norm <= options_.tolerance * scale || small_update) {
-      if (jacobian.determinant() * reference_determinant_ <= 0.0) break;
-      statistics_.record(iteration);
-      has_f_ = true;
-      return D;
-    }
-    if (iteration == options_.max_iterations) break;
-    const Eigen::Vector3d update = jacobian.partialPivLu().solve(r);
-    f_ -= update;
-    small_update = update.lpNorm<Eigen::Infinity>() <= options_.tolerance * f_.lpNorm<Eigen::Infinity>();
+  Equation equation{*this, g, {}, {}, {}};
+  const SolveReport report = newton_.solve(equation, statistics_);
+  if (report.converged() && equation.jacobian.determinant() * reference_determinant_ > 0.0) {
+    has_f_ = true;
+    return equation.D;
   }
   has_f_ = false;
-  throw NumericalFailure(too_far(linear.norm()), residuals_.back());
+  throw NumericalFailure(too_far(linear.norm()), report.residual);
 }
 
 Eigen::Vector3d LieGroupVelocityVerlet::torque(const Eigen::Matrix3d& R) {

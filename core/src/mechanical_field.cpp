@@ -33,6 +33,8 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       force_(n_),
       force_jacobian_(forces_ ? static_cast<Eigen::Index>(forces_->rows().size()) : 0),
       position_(n_),
+      absolute_(n_),
+      absolute_jet_(n_),
       force_jet_(n_),
       v_(n_),
       gradient_(2 * n_),
@@ -59,20 +61,33 @@ void MechanicalField::velocity(const Jet2* w, Jet2* v) const {
   std::copy(w, w + n_, v);
 }
 
-void MechanicalField::add_forces(const double* y, bool jacobian) {
-  forces_->evaluate(y[2 * n_], y, v_.data(), force_.data(), jacobian ? force_jacobian_.data() : nullptr);
+const double* MechanicalField::point(const double* y) {
+  if (origin_ == nullptr) return y;
+  for (int r = 0; r < n_; ++r) absolute_[r] = origin_[r].value + y[r];
+  return absolute_.data();
+}
+
+const Jet2* MechanicalField::point(const Jet2* y) {
+  if (origin_ == nullptr) return y;
+  for (int r = 0; r < n_; ++r) absolute_jet_[r] = origin_[r] + y[r];
+  return absolute_jet_.data();
+}
+
+void MechanicalField::add_forces(const double* y, const double* q, bool jacobian) {
+  forces_->evaluate(y[2 * n_], q, v_.data(), force_.data(), jacobian ? force_jacobian_.data() : nullptr);
   gradient_.head(n_) += force_;
   if (!jacobian) return;
   for (std::size_t e = 0; e < forces_->rows().size(); ++e)
     hessian_(forces_->rows()[e], forces_->cols()[e]) += force_jacobian_[static_cast<Eigen::Index>(e)];
 }
 
-void MechanicalField::force(const Jet2* y, const Jet2* v, Jet2* f) {
+void MechanicalField::force(const Jet2* state, const Jet2* v, Jet2* f) {
+  const Jet2* y = point(state);
   for (int r = 0; r < n_; ++r) {
     position_[r] = y[r].value;
     v_[r] = v[r].value;
   }
-  forces_->evaluate(y[2 * n_].value, position_.data(), v_.data(), force_.data(), force_jacobian_.data());
+  forces_->evaluate(state[2 * n_].value, position_.data(), v_.data(), force_.data(), force_jacobian_.data());
   for (int r = 0; r < n_; ++r) f[r] = Jet2(force_[r]);
   for (std::size_t e = 0; e < forces_->rows().size(); ++e) {
     const int col = forces_->cols()[e];
@@ -85,8 +100,9 @@ Status MechanicalField::eval(const double* y, double* f) noexcept {
   return guard([&] {
     if (space_ == PhaseSpace::cotangent) inverse_mass(y + n_, v_.data());
     else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
-    lagrangian_.gradient(y, v_.data(), gradient_.data());
-    if (forced_) add_forces(y, false);
+    const double* q = point(y);
+    lagrangian_.gradient(q, v_.data(), gradient_.data());
+    if (forced_) add_forces(y, q, false);
     Eigen::Map<Eigen::VectorXd>(f, n_) = v_;
     if (space_ == PhaseSpace::cotangent) Eigen::Map<Eigen::VectorXd>(f + n_, n_) = gradient_.head(n_);
     else inverse_mass(gradient_.data(), f + n_);
@@ -97,7 +113,7 @@ Status MechanicalField::eval(const double* y, double* f) noexcept {
 Status MechanicalField::eval(const Jet2* y, Jet2* f) noexcept {
   return guard([&] {
     velocity(y + n_, v_jet_.data());
-    lagrangian_.gradient_jet(y, v_jet_.data(), nullptr, gradient_jet_.data());
+    lagrangian_.gradient_jet(point(y), v_jet_.data(), nullptr, gradient_jet_.data());
     if (forced_) {
       force(y, v_jet_.data(), force_jet_.data());
       for (int r = 0; r < n_; ++r) gradient_jet_[r] += force_jet_[r];
@@ -119,8 +135,9 @@ Status MechanicalField::jacobian(const double* y, double* f, double* df) noexcep
   return guard([&] {
     if (space_ == PhaseSpace::cotangent) inverse_mass(y + n_, v_.data());
     else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
-    lagrangian_.hessian(y, v_.data(), gradient_.data(), hessian_.data());
-    if (forced_) add_forces(y, true);
+    const double* q = point(y);
+    lagrangian_.hessian(q, v_.data(), gradient_.data(), hessian_.data());
+    if (forced_) add_forces(y, q, true);
     const int N = size();
     Eigen::Map<Eigen::VectorXd> rate(f, N);
     Eigen::Map<Eigen::MatrixXd> J(df, N, N);

@@ -9,9 +9,7 @@ LagrangianEvaluator::LagrangianEvaluator(Lagrangian& lagrangian)
     : lagrangian_(lagrangian),
       m_(lagrangian.position_size()),
       n_(lagrangian.velocity_size()),
-      gradient_(m_ + n_),
-      residual_(n_),
-      update_(n_) {
+      gradient_(m_ + n_) {
   pattern_size_ = lagrangian_.hessian_pattern(&pattern_rows_, &pattern_cols_);
   if (pattern_size_ >= 0) {
     sparse_values_.resize(pattern_size_);
@@ -85,43 +83,56 @@ void LagrangianEvaluator::legendre(const double* q, const double* v, double* p) 
   Eigen::Map<Eigen::VectorXd>(p, n_) = gradient_.tail(n_);
 }
 
-// Newton's method on dL/dv (q, v) - p = 0 with the exact Jacobian d2L/dv2; L is assumed
-// hyperregular (paper, sec. 3 "Implementation issues": the initial guess for shooting).
+// dL/dv (q, v) = p in v, as a system for NewtonSolver (solve/newton.hpp), with the exact
+// Jacobian d2L/dv2; a sparse Lagrangian's velocity block is assembled from its pattern and
+// factorized by sparse LU.
+struct LagrangianEvaluator::InverseLegendre {
+  LagrangianEvaluator& l;
+  const double* q;
+  const double* p;
+  Eigen::Map<Eigen::VectorXd> v;
+
+  int size() const { return l.n_; }
+  // F's round-off yardstick: p, of the size of dL/dv.
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
+    const Eigen::Map<const Eigen::VectorXd> momentum(p, l.n_);
+    if (l.pattern_size_ < 0) {
+      l.hessian(q, v.data(), l.gradient_.data(), l.hessian_.data());
+    } else {
+      l.sparse_hessian(q, v.data(), l.gradient_.data(), l.sparse_values_.data());
+      l.triplets_.clear();
+      for (int e = 0; e < l.pattern_size_; ++e)
+        if (l.pattern_rows_[e] >= l.m_ && l.pattern_cols_[e] >= l.m_)
+          l.triplets_.emplace_back(l.pattern_rows_[e] - l.m_, l.pattern_cols_[e] - l.m_, l.sparse_values_[e]);
+      l.velocity_block_.setFromTriplets(l.triplets_.begin(), l.triplets_.end());
+    }
+    F = l.gradient_.tail(l.n_) - momentum;
+    return momentum.lpNorm<Eigen::Infinity>();
+  }
+  void factorize() {
+    if (l.pattern_size_ < 0) l.lu_.compute(l.hessian_.bottomRightCorner(l.n_, l.n_));
+    else l.sparse_lu_.compute(l.velocity_block_);
+  }
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) {
+    if (l.pattern_size_ < 0) update.noalias() = l.lu_.solve(F);
+    else update = l.sparse_lu_.solve(F);
+  }
+  double apply(const Eigen::VectorXd& update) {
+    v -= update;
+    return v.lpNorm<Eigen::Infinity>();
+  }
+  void finish(const Eigen::VectorXd&) {}
+};
+
+// Newton's method on dL/dv (q, v) - p = 0; L is assumed hyperregular (paper, sec. 3
+// "Implementation issues": the initial guess for shooting).
 void LagrangianEvaluator::inverse_legendre(const double* q, const double* p, double* v,
                                            const SolverOptions& options) {
-  Eigen::Map<Eigen::VectorXd> velocity(v, n_);
-  const Eigen::Map<const Eigen::VectorXd> momentum(p, n_);
-  double residual_norm = 0.0;
-  for (int iteration = 0; iteration < options.max_iterations; ++iteration) {
-    velocity_newton_update(q, v, p);
-    residual_norm = residual_.lpNorm<Eigen::Infinity>();
-    if (options.converged(residual_norm, momentum.lpNorm<Eigen::Infinity>())) return;
-    velocity -= update_;
-    if (options.converged(update_.lpNorm<Eigen::Infinity>(), velocity.lpNorm<Eigen::Infinity>())) return;
-  }
-  throw NumericalFailure("the inverse Legendre transform did not converge", residual_norm);
-}
-
-// residual_ = dL/dv (q, v) - p and the Newton update solving d2L/dv2 update = residual_; a sparse
-// Lagrangian's velocity block is assembled from its pattern and factorized by sparse LU.
-void LagrangianEvaluator::velocity_newton_update(const double* q, const double* v, const double* p) {
-  if (pattern_size_ < 0) {
-    hessian(q, v, gradient_.data(), hessian_.data());
-    lu_.compute(hessian_.bottomRightCorner(n_, n_));
-  } else {
-    sparse_hessian(q, v, gradient_.data(), sparse_values_.data());
-    triplets_.clear();
-    for (int e = 0; e < pattern_size_; ++e)
-      if (pattern_rows_[e] >= m_ && pattern_cols_[e] >= m_)
-        triplets_.emplace_back(pattern_rows_[e] - m_, pattern_cols_[e] - m_, sparse_values_[e]);
-    velocity_block_.setFromTriplets(triplets_.begin(), triplets_.end());
-    sparse_lu_.compute(velocity_block_);
-  }
-  residual_ = gradient_.tail(n_) - Eigen::Map<const Eigen::VectorXd>(p, n_);
-  if (pattern_size_ < 0)
-    update_.noalias() = lu_.solve(residual_);
-  else
-    update_ = sparse_lu_.solve(residual_);
+  if (legendre_solver_.options().tolerance != options.tolerance ||
+      legendre_solver_.options().max_iterations != options.max_iterations)
+    legendre_solver_ = NewtonSolver(options);
+  InverseLegendre equations{*this, q, p, Eigen::Map<Eigen::VectorXd>(v, n_)};
+  require_converged(legendre_solver_.solve(equations), "the inverse Legendre transform's equations");
 }
 
 double LagrangianEvaluator::energy(const double* q, const double* v) {

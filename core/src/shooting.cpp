@@ -3,6 +3,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "varia/core/compensated.hpp"
+
 #include "varia/core/rotation_field.hpp"
 
 namespace varia {
@@ -64,6 +66,7 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
       method_(method),
       form_(form),
       options_(options),
+      solver_(options),
       m_(manifold.point_size()),
       n_(manifold.dim()) {
   method_.set_solver(options.tolerance, options.max_iterations);
@@ -121,14 +124,25 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   lambda_.resize(n_);
   D1_.resize(n_);
   residual_.resize(n_);
-  update_.resize(n_);
+  lambda_jacobian_.resize(n_, n_);
+  offset_.resize(n_);
+  momentum_change_.resize(n_);
+  carry_q_ = Eigen::VectorXd::Zero(n_);
+  carry_p_ = Eigen::VectorXd::Zero(n_);
+  end_q_.resize(n_);
+  end_p_.resize(n_);
+  origin_.resize(n_);
+  if (mechanical_ != nullptr) mechanical_->set_origin(origin_.data());
   Bq_.resize(n_, n_);
   Bw_.resize(n_, n_);
   phi_.resize(2 * n_, 2 * n_);
   jacobian_.resize(n_, n_);
   BwT_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
   jacobian_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
-  residuals_.reserve(options_.max_iterations + 1);
+}
+
+const Jet2* ShootingDiscreteLagrangian::position() {
+  return mechanical_ != nullptr ? mechanical_->point(state_.data()) : state_.data();
 }
 
 // The quadrature's contribution at node i: h b_i L(q^i, v^i), plus the Euler-Maclaurin end
@@ -141,7 +155,7 @@ void ShootingDiscreteLagrangian::accumulate(int node, double h, Jet2& S) {
   if (mechanical_ != nullptr) mechanical_->velocity(&state_[m_], v_.data());
   else std::copy_n(state_.begin() + m_, n_, v_.begin());
   Jet2 L;
-  lagrangian_.gradient_jet(state_.data(), v_.data(), &L, gradient_.data());
+  lagrangian_.gradient_jet(position(), v_.data(), &L, gradient_.data());
   S += (h * weights_[node]) * L;
   if (forced_) add_work(h * weights_[node]);
   if (correction == 0.0) return;
@@ -156,8 +170,9 @@ void ShootingDiscreteLagrangian::accumulate(int node, double h, Jet2& S) {
 // (Marsden & West 2001, sec. 3.2, through the quadrature; see shooting.hpp).
 void ShootingDiscreteLagrangian::add_work(double weight) {
   mechanical_->force(state_.data(), v_.data(), force_.data());
+  const Jet2* point = position();
   for (int r = 0; r < n_; ++r) {
-    const Jet2& q = state_[r];
+    const Jet2& q = point[r];
     const double f = weight * force_[r].value;
     alpha_ += f * q.gradient;
     work_jacobian_ += f * q.hessian;
@@ -167,11 +182,16 @@ void ShootingDiscreteLagrangian::add_work(double weight) {
 
 // q^0 = q0 exp(eta) at eta = 0 as jets in x = (eta, w0), the natural chart at q0 (paper, sec. 2
 // "Natural charts"): eta carries D1 L_d, left-trivialized on a Lie group. On a vector space the
-// chart is q0 + eta; otherwise the manifold's chart gives q0 exp(eta) exp(xi) in (eta, xi),
-// whose xi-derivatives (xi = 0) are dropped: the variables n..2n-1 are w0 here.
+// chart is q0 + eta, held as the field's origin, and the state's positions are the offsets
+// q^i - (q0 + eta), starting at 0 (position()). Otherwise the manifold's chart gives
+// q0 exp(eta) exp(xi) in (eta, xi), whose xi-derivatives (xi = 0) are dropped: the variables
+// n..2n-1 are w0 here.
 void ShootingDiscreteLagrangian::start_point(const double* q0) {
   if (manifold_.is_vector_space()) {
-    for (int r = 0; r < n_; ++r) state_[r] = Jet2::variable(q0[r], 2 * n_, r);
+    for (int r = 0; r < n_; ++r) {
+      origin_[r] = Jet2::variable(q0[r], 2 * n_, r);
+      state_[r] = Jet2(0.0);
+    }
     return;
   }
   const int V = 2 * n_;
@@ -207,7 +227,8 @@ void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, doubl
   }
   if (type_2()) {
     generating_ = -S;  // H_d^+ = <p^n, q^n> - S
-    for (int r = 0; r < n_; ++r) generating_ += state_[n_ + r] * state_[r];
+    const Jet2* point = position();
+    for (int r = 0; r < n_; ++r) generating_ += state_[n_ + r] * point[r];
     std::copy_n(state_.begin() + n_, n_, boundary_.begin());
   } else {
     generating_ = S;
@@ -220,7 +241,8 @@ void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, doubl
 // B = 0, lambda = dG/dB is D2 L_d left-trivialized at q1 (q1 exp(B) = q^n). The chart is at the
 // given q1 when evaluating L_d, and at q^n's own value in a step (where q1 is the outcome), so
 // that B = 0 there; its second derivatives enter Phi. On a vector space B = q^n - q1, taken as
-// q^n (the targets subtract q1).
+// the offset q^n - (q0 + eta) (the targets subtract q1 - q0; B's derivative in eta is then the
+// offset's plus I, see differentiate()).
 void ShootingDiscreteLagrangian::boundary() {
   if (manifold_.is_vector_space()) {
     std::copy_n(state_.begin(), n_, boundary_.begin());
@@ -254,6 +276,8 @@ void ShootingDiscreteLagrangian::boundary() {
 
 // lambda = B_w^{-T} alpha_w, D1 = alpha_q - B_q^T lambda, Phi = d alpha/dx - sum_r lambda_r Hess B_r,
 // alpha = G_x (+ W_x with forces; Phi's rows are alpha's components, its columns the variables).
+// With offsets (on a vector space, Type I forms) B_q = I + Bq_, and the momentum change of the
+// step is D1 + D2 = alpha_q - Bq_^T lambda: small terms, each to its own relative precision.
 void ShootingDiscreteLagrangian::differentiate() {
   for (int r = 0; r < n_; ++r) {
     Bq_.row(r) = boundary_[r].gradient.head(n_).transpose();
@@ -263,6 +287,10 @@ void ShootingDiscreteLagrangian::differentiate() {
   lambda_.noalias() = BwT_lu_.solve(alpha_.tail(n_));
   D1_ = alpha_.head(n_);
   D1_.noalias() -= Bq_.transpose() * lambda_;
+  if (offsets()) {
+    momentum_change_ = D1_;
+    D1_ -= lambda_;
+  }
   phi_ = generating_.hessian;
   if (forced_) phi_ += work_jacobian_;
   for (int r = 0; r < n_; ++r) phi_ -= lambda_[r] * boundary_[r].hessian;
@@ -280,8 +308,10 @@ void ShootingDiscreteLagrangian::residual(Target target, const double* data) {
       residual_ = D1_;
       if (type_2()) residual_ -= given;
       else residual_ += given;
+      lambda_jacobian_.noalias() = BwT_lu_.solve(phi_ww);
       jacobian_ = phi_.topRightCorner(n_, n_);
-      jacobian_.noalias() -= Bq_.transpose() * BwT_lu_.solve(phi_ww);
+      jacobian_.noalias() -= Bq_.transpose() * lambda_jacobian_;
+      if (offsets()) jacobian_ -= lambda_jacobian_;
       break;
     case Target::boundary:
       for (int r = 0; r < n_; ++r) residual_[r] = boundary_[r].value - given[r];
@@ -294,35 +324,65 @@ void ShootingDiscreteLagrangian::residual(Target target, const double* data) {
   }
 }
 
-// Newton's method with the exact Jacobian on w0 (starting from w_), until the residual or the
-// update is at the tolerance; the last shot stays in the workspace for the outputs.
+// The shooting equations in w0 (residual(): the target's), as a system for NewtonSolver
+// (solve/newton.hpp), with the exact Jacobian.
+struct ShootingDiscreteLagrangian::Equations {
+  ShootingDiscreteLagrangian& s;
+  const double* q0;
+  double h;
+  Target target;
+  const double* data;
+
+  int size() const { return s.n_; }
+  // F's round-off yardstick: the largest of its terms, the given data and D1 (momentum) or B.
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
+    s.shoot(q0, s.w_.data(), h);
+    s.differentiate();
+    s.residual(target, data);
+    F = s.residual_;
+    double yardstick = Eigen::Map<const Eigen::VectorXd>(data, s.n_).lpNorm<Eigen::Infinity>();
+    if (target == Target::momentum) return std::max(yardstick, s.D1_.lpNorm<Eigen::Infinity>());
+    for (int r = 0; r < s.n_; ++r) yardstick = std::max(yardstick, std::abs(s.boundary_[r].value));
+    return yardstick;
+  }
+  void factorize() { s.jacobian_lu_.compute(s.jacobian_); }
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { update.noalias() = s.jacobian_lu_.solve(F); }
+  double apply(const Eigen::VectorXd& update) {
+    s.w_ -= update;
+    return s.w_.lpNorm<Eigen::Infinity>();
+  }
+  // The step's outcome at the updated w0, to first order from the last shot (no propagation):
+  // the state's values by their w0-derivatives, lambda by dlambda/dw0 = B_w^{-T} Phi_ww, the
+  // momentum change by dD1/dw0 + dlambda/dw0, the residual by its Jacobian.
+  void finish(const Eigen::VectorXd& update) {
+    if (target != Target::momentum) return;
+    for (int r = 0; r < s.m_; ++r)
+      if (!s.state_[r].constant()) s.state_[r].value -= s.state_[r].gradient.tail(s.n_).dot(update);
+    for (int r = 0; r < s.n_; ++r)
+      if (!s.boundary_[r].constant()) s.boundary_[r].value -= s.boundary_[r].gradient.tail(s.n_).dot(update);
+    s.lambda_.noalias() -= s.lambda_jacobian_ * update;
+    if (s.offsets()) {
+      s.momentum_change_.noalias() -= s.jacobian_ * update;
+      s.momentum_change_.noalias() -= s.lambda_jacobian_ * update;
+    }
+    s.residual_.noalias() -= s.jacobian_ * update;
+  }
+};
+
+// Newton's method with the exact Jacobian on w0 (starting from w_); the last shot stays in the
+// workspace for the outputs, brought to the solution to first order (Equations::finish).
 void ShootingDiscreteLagrangian::solve(const double* q0, double h, Target target,
                                        const double* data) {
-  residuals_.clear();
-  const double scale = Eigen::Map<const Eigen::VectorXd>(data, n_).lpNorm<Eigen::Infinity>();
-  bool settled = false;
-  for (int iteration = 0;; ++iteration) {
-    shoot(q0, w_.data(), h);
-    differentiate();
-    residual(target, data);
-    const double norm = residual_.lpNorm<Eigen::Infinity>();
-    residuals_.push_back(norm);
-    if (!std::isfinite(norm))
-      throw NumericalFailure("the shooting equations have a non-finite residual", norm);
-    if (settled || options_.converged(norm, scale)) return statistics_.record(iteration);
-    if (iteration == options_.max_iterations)
-      throw NumericalFailure("the shooting Newton iteration did not converge in " +
-                                 std::to_string(options_.max_iterations) + " iterations",
-                             norm);
-    jacobian_lu_.compute(jacobian_);
-    update_.noalias() = jacobian_lu_.solve(residual_);
-    w_ -= update_;
-    settled = options_.converged(update_.lpNorm<Eigen::Infinity>(), w_.lpNorm<Eigen::Infinity>());
-  }
+  Equations equations{*this, q0, h, target, data};
+  require_converged(solver_.solve(equations, statistics_), "the shooting equations");
 }
 
 // The paper's shooting-based implementation: w0 = v0 from the inverse Legendre transform
 // v0 = M^{-1} p0 (Lagrangian form), or w0 = p^0 guessed as p0 (Hamiltonian forms).
+// On a vector space in a Type I form, q1 = q0 + (q^n - q0) and p1 = p0 + (D1 L_d + D2 L_d) - r
+// (r = p0 + D1 L_d, the residual left; with forces D1 and D2 include f_d^-, f_d^+), the
+// increments summed with Kahan's compensation across steps (compensated.hpp) while each step
+// continues from the last one's output, as the Galerkin construction does.
 void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, double t0, double h, double* q1,
                                       double* p1) {
   forced_ = !forces_.empty();
@@ -335,6 +395,21 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   if (type_2()) {
     for (int r = 0; r < n_; ++r) p[r] = boundary_[r].value;
     Eigen::Map<Eigen::VectorXd>(q1, n_) = lambda_;
+  } else if (offsets()) {
+    const Eigen::Map<const Eigen::VectorXd> start(q0, n_), momentum(p0, n_);
+    if (!(continuing_ && end_q_ == start && end_p_ == momentum)) {
+      carry_q_.setZero();
+      carry_p_.setZero();
+    }
+    for (int r = 0; r < n_; ++r) offset_[r] = state_[r].value;
+    momentum_change_ -= residual_;
+    end_q_ = start;
+    compensated_add(end_q_, offset_, carry_q_);
+    end_p_ = momentum;
+    compensated_add(end_p_, momentum_change_, carry_p_);
+    Eigen::Map<Eigen::VectorXd>(q1, n_) = end_q_;
+    p = end_p_;
+    continuing_ = true;
   } else {
     for (int r = 0; r < m_; ++r) q1[r] = state_[r].value;
     p = lambda_;  // with forces p1 = D2 L_d + f_d^+
@@ -356,9 +431,16 @@ void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
   if (form_ != ShootingForm::lagrangian) w_ = field_->mass() * w_;
   target_is_end_ = false;
   std::copy_n(q1, m_, target_.begin());
-  // On a vector space B = q^n against q1; through the chart at q1, B = local(q1, q^n) against 0.
-  solve(q0, h, type_2() ? Target::lambda : Target::boundary,
-        manifold_.is_vector_space() ? q1 : zero_.data());
+  // On a vector space B = q^n - q0 against q1 - q0 (type-2: lambda against q1); through the chart
+  // at q1, B = local(q1, q^n) against 0.
+  if (type_2()) {
+    solve(q0, h, Target::lambda, q1);
+  } else if (offsets()) {
+    offset_ = Eigen::Map<const Eigen::VectorXd>(q1, n_) - Eigen::Map<const Eigen::VectorXd>(q0, n_);
+    solve(q0, h, Target::boundary, offset_.data());
+  } else {
+    solve(q0, h, Target::boundary, zero_.data());
+  }
   double p1_q1 = 0.0;
   for (int r = 0; r < n_; ++r) p1_q1 += boundary_[r].value * lambda_[r];
   if (Ld != nullptr) *Ld = type_2() ? p1_q1 - generating_.value : generating_.value;

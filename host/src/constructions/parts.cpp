@@ -42,9 +42,18 @@ nlohmann::json method_schema(const char* construction, nlohmann::json keys, std:
         {"type", "object"},
         {"additionalProperties", false},
         {"properties",
-         {{"tolerance", {{"description", "the Newton tolerance"}, {"type", "number"}, {"exclusiveMinimum", 0}}},
+         {{"tolerance",
+           {{"description",
+             "the Newton stopping rule's tolerance: a solve ends when the residual is within tolerance (1 + the size "
+             "of its terms), the update within tolerance (1 + the size of the unknowns), or the residual stagnates "
+             "at round-off (docs/architecture.md)"},
+            {"type", "number"},
+            {"exclusiveMinimum", 0}}},
           {"max_iterations",
-           {{"description", "the Newton iteration limit"}, {"type", "integer"}, {"minimum", 1}, {"maximum", 1000000}}}}}}}};
+           {{"description", "the most Newton updates a solve may take before it is a numerical failure (exit 4)"},
+            {"type", "integer"},
+            {"minimum", 1},
+            {"maximum", 1000000}}}}}}}};
   properties.update(keys);
   required.insert(required.begin(), "construction");
   return {{"description", std::string("the method of construction '") + construction + "'"},

@@ -1,6 +1,6 @@
 // The discrete Hamiltonian map (paper, eq. IDEL): (q_k, p_k) -> (q_{k+1}, p_{k+1}), the one-step
-// method that every construction provides, and the bookkeeping shared by all of them: solver
-// options, evaluation counters, Newton statistics, and the numerical failure they raise.
+// method that every construction provides, and the bookkeeping shared by all of them: evaluation
+// counters, and (solve/newton.hpp) solver options, Newton statistics and the numerical failure.
 #pragma once
 
 #include <algorithm>
@@ -9,14 +9,9 @@
 #include <stdexcept>
 #include <string>
 
-namespace varia {
+#include "varia/core/solve/newton.hpp"
 
-struct SolverOptions {
-  double tolerance = 1e-14;  // on the scaled residual or the scaled Newton update
-  int max_iterations = 50;
-  // The convergence test of every solve: |value| <= tolerance (1 + |scale|).
-  bool converged(double value, double scale) const { return value <= tolerance * (1.0 + scale); }
-};
+namespace varia {
 
 // Plugin evaluations made so far (the run record's "evaluations").
 struct EvaluationCounters {
@@ -24,34 +19,6 @@ struct EvaluationCounters {
   long gradient = 0;
   long hessian = 0;
   long force = 0;  // evaluations of the sum of the system's forces
-};
-
-// Newton statistics of the steps made so far.
-struct SolverStatistics {
-  long solves = 0;
-  long iterations = 0;
-  int max_iterations = 0;
-  void record(int iterations_of_one_solve) {
-    ++solves;
-    iterations += iterations_of_one_solve;
-    if (iterations_of_one_solve > max_iterations) max_iterations = iterations_of_one_solve;
-  }
-  double mean() const { return solves ? static_cast<double>(iterations) / solves : 0.0; }
-};
-
-// A nonlinear solve that did not converge, or a non-finite value. The host adds the step index
-// and time; `residual` is the last residual norm (NaN when not applicable).
-// `origin` is that of the plugin object whose output was not finite (plugin_object.hpp), if one was.
-class NumericalFailure : public std::runtime_error {
- public:
-  NumericalFailure(const std::string& what, double residual, const void* origin = nullptr)
-      : std::runtime_error(what), residual_(residual), origin_(origin) {}
-  double residual() const { return residual_; }
-  const void* origin() const { return origin_; }
-
- private:
-  double residual_;
-  const void* origin_;
 };
 
 // The time travels with the state: every step is taken from a state (q0, p0) at a time t0 that the

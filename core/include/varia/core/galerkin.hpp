@@ -25,6 +25,7 @@
 #include "varia/core/manifold.hpp"
 #include "varia/core/mechanics.hpp"
 #include "varia/core/quadrature.hpp"
+#include "varia/core/solve/newton.hpp"
 
 namespace varia {
 
@@ -60,7 +61,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override;
   // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).
-  const std::vector<double>& last_residuals() const { return residuals_; }
+  const std::vector<double>& last_residuals() const { return solver_.residuals(); }
 
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
@@ -98,13 +99,11 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // where p0 (if not null) is added to the equation nu = 0 (IDEL: p0 + D1 L_d + f_d^0 = 0).
   void newton(double h, int first_unknown, int first_equation, int blocks, const double* p0,
               bool forced);
-  // Solves J update = residual with the Jacobian block of the current equations and unknowns,
-  // factorized anew or (refactor false) as last factorized.
-  void solve_dense(int first_unknown, int first_equation, int blocks, bool refactor);
-  void solve_sparse(bool refactor);
+  struct Equations;  // those equations as a NewtonSolver system
+  void factorize_sparse();
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
-  void gradient_after_update(double h, int first_unknown, int size, bool forced);
+  void gradient_after_update(double h, int first_unknown, const Eigen::VectorXd& update, bool forced);
   void warm_start(const double* q0, const double* p0, double h);
   // Degree 1 with nodes only at 0 and 1 and a constant mass matrix M: the IDEL equations are
   // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton. The steps are
@@ -123,6 +122,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::VectorXd weights_, nodes_;
   Eigen::MatrixXd extrapolation_;  // l_mu(1 + d_nu): the last step's curve continued
   SolverOptions options_;
+  NewtonSolver solver_;
   SolverStatistics statistics_;
   int n_, s_;
   // Workspace, sized once: a step allocates nothing.
@@ -142,10 +142,9 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::VectorXd carry_q_, carry_p_, end_p_, impulse_;
   Eigen::VectorXd change_;  // the gradient's change by a Newton update, (s+1) n
   Eigen::VectorXd column_;  // add_hessian's two columns, 2n
-  Eigen::VectorXd q_, v_, grad_, gradient_, residual_, update_, velocity_;
-  Eigen::MatrixXd hess_, hessian_, jacobian_;
-  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
-  std::vector<double> residuals_;
+  Eigen::VectorXd q_, v_, grad_, gradient_, velocity_;
+  Eigen::MatrixXd hess_, hessian_;
+  DenseLinearization dense_;  // the dense Newton Jacobian (block of hessian_)
   // The entries of a Hessian of L, then of the forces' Jacobian, as (row, col) in an n x n block
   // with whether the row and column differentiate by v (else by q).
   struct Entry {

@@ -34,6 +34,7 @@
 #include "varia/core/manifold.hpp"
 #include "varia/core/mechanics.hpp"
 #include "varia/core/quadrature.hpp"
+#include "varia/core/solve/newton.hpp"
 
 namespace varia {
 
@@ -56,7 +57,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
   // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).
-  const std::vector<double>& last_residuals() const { return residuals_; }
+  const std::vector<double>& last_residuals() const { return solver_.residuals(); }
 
  private:
   // S (also kept in action_) and, in gradient_ and (with_hessian) hessian_, its derivatives in (eta, xi^1, ..., xi^s)
@@ -70,7 +71,16 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   // The residual of the step's equations [p0 + D1 L_d; dS/dxi^1..s-1] (evaluate: internal only)
   // and its Jacobian in the unknowns.
   void step_equations(const double* p0);
+  struct Equations;  // those equations as a NewtonSolver system
   void newton(const double* q0, const double* p0, double h);
+  // The compensated final update (see step()): dexp's slopes at 0, and g0 exp(xi) - g0.
+  void dexp_slopes(const double* q0);
+  bool point_increment(const double* q0, const Eigen::Ref<const Eigen::VectorXd>& xi);
+  struct GaussRule {
+    Eigen::VectorXd nodes, weights;  // on [0, 1]
+    double bound;                    // the error constant E_k
+  };
+  static GaussRule gauss_legendre(int k);
   void warm_start(const double* q0, const double* p0, double h);
   void check(Status status) const;
 
@@ -80,14 +90,19 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   Eigen::VectorXd weights_;
   Eigen::MatrixXd extrapolation_;  // l_mu(1 + d_nu): the last step's curve continued
   SolverOptions options_;
+  NewtonSolver solver_;
   SolverStatistics statistics_;
   bool reduced_;
   int m_, n_, s_;
-  std::vector<double> residuals_;
   // Workspace, sized once: a step allocates nothing.
   Eigen::MatrixXd xi_;        // n x (s+1) control points in the chart, column 0 = 0
   Eigen::MatrixXd previous_;  // the last step's control points
-  Eigen::VectorXd previous_base_, last_end_;  // the last step's g0 and g1
+  Eigen::VectorXd previous_base_, last_end_, last_p_;  // the last step's g0, g1 and p1
+  // Compensated sums g1 = g0 + (g1 - g0), p1 = p0 + (p1 - p0) across steps (compensated.hpp):
+  // the running compensations and the increments.
+  Eigen::VectorXd carry_g_, carry_p_, point_change_, momentum_change_;
+  std::vector<Eigen::MatrixXd> dexp_slopes_;  // d dexp_w / dw_l at w = 0, once
+  std::vector<GaussRule> increment_rules_;    // k = 1 .. 10 nodes
   double previous_h_ = 0.0;
   bool has_previous_ = false;
   // The chart at a node (Manifold::chart): values, gradients and Hessians, component-major.
@@ -100,7 +115,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   Eigen::MatrixXd dexp_, dexp_inverse_T_;            // dexp_{w}, dexp_w^{-T}
   std::vector<Eigen::MatrixXd> dexp_derivative_;     // d dexp_w / dw_l
   Eigen::PartialPivLU<Eigen::MatrixXd> dexp_lu_, lu_;
-  Eigen::VectorXd residual_, update_, momentum_;
+  Eigen::VectorXd residual_, momentum_;
   Eigen::MatrixXd jacobian_;
   int unknowns_ = 0;  // the leading control points solved for: s (step) or s - 1 (evaluate)
 };

@@ -47,12 +47,13 @@ class LieGroupVelocityVerlet : public DiscreteLagrangian, public DiscreteHamilto
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
   // Residual norms of the last Newton solve, one per iteration.
-  const std::vector<double>& last_residuals() const { return residuals_; }
+  const std::vector<double>& last_residuals() const { return newton_.residuals(); }
 
  private:
   // Residual r(f) of the solver's equation for g, its Jacobian, and F - I.
   void residual(const Eigen::Vector3d& f, const Eigen::Vector3d& g, Eigen::Vector3d& r,
                 Eigen::Matrix3d& jacobian, Eigen::Matrix3d& F_minus_I) const;
+  struct Equation;  // the equation for f as a NewtonSolver system
   // Solves F J_d - J_d F^T = hat(g) for F on the branch through the identity; returns F - I.
   Eigen::Matrix3d solve(const Eigen::Vector3d& g);
   // M = the left-trivialized dL/dR at (R, Omega = 0): the potential's torque on the body.
@@ -64,10 +65,10 @@ class LieGroupVelocityVerlet : public DiscreteLagrangian, public DiscreteHamilto
   LagrangianEvaluator lagrangian_;
   LieVerletSolver solver_;
   SolverOptions options_;
+  NewtonSolver newton_;
   SolverStatistics statistics_;
   Eigen::Matrix3d J_, Jd_;
   double reference_determinant_;  // det of the Jacobian at f = 0, g = 0: the identity's branch
-  std::vector<double> residuals_;
   std::array<double, 12> gradient_{};  // [dL/dR row-major, dL/dOmega]
 
   // The state carried from one step to the next: the last solution f (warm start), the last

@@ -93,6 +93,14 @@ class MechanicalField final : public EulerLagrangeField {
   // The velocity of a state's second half: v = w (tangent) or M^{-1} w (cotangent).
   void velocity(const Jet2* w, Jet2* v) const;
 
+  // The state's positions as offsets from `origin` (n jets, kept by the caller; null: none): the
+  // field is evaluated at origin + offset. Every Runge-Kutta method commutes with the translation,
+  // and the propagated offsets carry errors of their own size, not of |q| (the shooting
+  // construction's endpoints, shooting.hpp).
+  void set_origin(const Jet2* origin) { origin_ = origin; }
+  // The positions of state y: origin + y's offsets (in a workspace, valid until the next call),
+  // or y's own.
+  const Jet2* point(const Jet2* y);
   // Whether the state carries the time (the field has forces), and whether they are applied.
   bool clock() const { return forces_ != nullptr; }
   void set_forced(bool forced) { forced_ = forced && clock(); }
@@ -105,12 +113,16 @@ class MechanicalField final : public EulerLagrangeField {
  private:
   // Adds the forces at the values of y (velocity v_) to gradient_.head(n) (= L_q + f), and with
   // `jacobian` their Jacobian to the rows of hessian_ (d(L_q + f)/d(q, v)).
-  void add_forces(const double* y, bool jacobian);
+  void add_forces(const double* y, const double* q, bool jacobian);
+  const double* point(const double* y);
 
   PhaseSpace space_;
   Forces* forces_;
   bool forced_ = false;
   Eigen::VectorXd force_, force_jacobian_, position_;
+  const Jet2* origin_ = nullptr;
+  Eigen::VectorXd absolute_;
+  std::vector<Jet2> absolute_jet_;
   std::vector<Jet2> force_jet_;
   // Workspace, sized once.
   Eigen::VectorXd v_, gradient_;

@@ -63,21 +63,21 @@ class LagrangianEvaluator {
     ++counters_.gradient;
     check_finite(gradient, m_ + n_, "gradient");
   }
-  // One Newton step of the inverse Legendre transform: residual_ and update_ (see the .cpp).
-  void velocity_newton_update(const double* q, const double* v, const double* p);
+  struct InverseLegendre;  // dL/dv (q, v) = p as a NewtonSolver system
   Lagrangian& lagrangian_;
   int m_, n_;
   const int* pattern_rows_ = nullptr;
   const int* pattern_cols_ = nullptr;
   int pattern_size_ = -1;
   // Workspace, sized once: an evaluation allocates nothing.
-  Eigen::VectorXd sparse_values_, gradient_, residual_, update_;
+  Eigen::VectorXd sparse_values_, gradient_;
   Eigen::MatrixXd hessian_;                 // dense Lagrangians only
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;  // dense Lagrangians only
   Eigen::SparseMatrix<double> velocity_block_;  // sparse Lagrangians: d2L/dv2
   Eigen::SparseLU<Eigen::SparseMatrix<double>> sparse_lu_;
   std::vector<Eigen::Triplet<double>> triplets_;
   EvaluationCounters counters_;
+  NewtonSolver legendre_solver_;
 };
 
 }  // namespace varia

@@ -70,6 +70,7 @@
 #include "varia/core/mechanics.hpp"
 #include "varia/core/one_step.hpp"
 #include "varia/core/quadrature.hpp"
+#include "varia/core/solve/newton.hpp"
 
 namespace varia {
 
@@ -101,7 +102,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   const SolverStatistics& stage_statistics() const { return stages_; }
   const EvaluationCounters& evaluations() const override;
   // Residual norms of the last shooting solve, one per iteration (quadratic convergence).
-  const std::vector<double>& last_residuals() const { return residuals_; }
+  const std::vector<double>& last_residuals() const { return solver_.residuals(); }
 
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
@@ -120,8 +121,13 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void add_work(double weight);
   void differentiate();
   void residual(Target target, const double* data);
+  struct Equations;  // the shooting equations as a NewtonSolver system
   void solve(const double* q0, double h, Target target, const double* data);
   bool type_2() const { return form_ == ShootingForm::type_2; }
+  // The boundary quantity is the offset q^n - (q0 + eta): a vector space, Type I forms.
+  bool offsets() const { return mechanical_ != nullptr && !type_2(); }
+  // The positions of the state: origin_ + offsets on a vector space, else the state's own.
+  const Jet2* position();
 
   Manifold& manifold_;
   LagrangianEvaluator lagrangian_;
@@ -131,6 +137,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   OneStepMethod& method_;
   ShootingForm form_;
   SolverOptions options_;
+  NewtonSolver solver_;
   int m_, n_;  // point_size, dim
   std::vector<double> nodes_, weights_;  // with 0 and 1 included
   double start_correction_ = 0.0, end_correction_ = 0.0;  // a_1, z_1 (Euler-Maclaurin)
@@ -140,17 +147,22 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   std::vector<double> target_, zero_ = std::vector<double>(kMaxJetVariables, 0.0);
   SolverStatistics statistics_, stages_;
   mutable EvaluationCounters counters_;
-  std::vector<double> residuals_;
   // Workspace, sized once: a step allocates nothing.
   std::vector<Jet2> state_, next_, v_, acceleration_, gradient_, boundary_, force_;
+  std::vector<Jet2> origin_;  // q0 + eta: the origin of the state's positions on a vector space
   Jet2 generating_;
   // The natural chart's derivatives (Manifold::chart, local_derivatives), component-major.
   std::vector<double> end_, chart_value_, chart_gradient_, chart_hessian_, local_value_, local_gradient_,
       local_hessian_;
-  Eigen::VectorXd w_, lambda_, D1_, residual_, update_;
+  Eigen::VectorXd w_, lambda_, D1_, residual_;
   Eigen::VectorXd alpha_;        // G_x + W_x: the forced 1-form in x = (q0, w0)
   Eigen::MatrixXd work_jacobian_;  // dW_x/dx
   Eigen::MatrixXd Bq_, Bw_, phi_, jacobian_;
+  Eigen::MatrixXd lambda_jacobian_;  // dlambda/dw0 = B_w^{-T} Phi_ww
+  // Compensated sums q1 = q0 + (q^n - q0), p1 = p0 + (p1 - p0) across steps (compensated.hpp):
+  // the increments, the running compensations, and the last output with whether it is one.
+  Eigen::VectorXd offset_, momentum_change_, carry_q_, carry_p_, end_q_, end_p_;
+  bool continuing_ = false;
   Eigen::PartialPivLU<Eigen::MatrixXd> BwT_lu_, jacobian_lu_;  // of B_w^T and the Jacobian
 };
 

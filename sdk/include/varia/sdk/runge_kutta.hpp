@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "varia/core/one_step.hpp"
+#include "varia/core/solve/newton.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::sdk {
@@ -90,8 +91,7 @@ class RungeKutta : public OneStepMethod {
   bool self_adjoint() const noexcept final { return self_adjoint_; }
   const char* equivariance() const noexcept final { return "affine"; }
   void set_solver(double tolerance, int max_iterations) noexcept final {
-    tolerance_ = tolerance;
-    max_iterations_ = max_iterations;
+    newton_ = NewtonSolver(SolverOptions{tolerance, max_iterations});
   }
   Status step(VectorField& field, double h, const double* y0, double* y1,
               StageSolve* report) noexcept final {
@@ -175,32 +175,47 @@ class RungeKutta : public OneStepMethod {
     newton_matrix_ += Eigen::MatrixXd::Identity(s * N, s * N);
   }
 
-  // Newton's method on G(K) = 0 from K_i = f(y0), the exact Jacobian at every iteration.
+  // The stage equations G(K) = 0 at y0 as a system for varia's NewtonSolver (core/solve/
+  // newton.hpp), with the exact Jacobian; the stages K in doubles_.K.
+  struct StageEquations {
+    RungeKutta& rk;
+    VectorField& field;
+    double h;
+    const double* y0;
+
+    int size() const { return static_cast<int>(rk.doubles_.K.size()); }
+    Eigen::Map<Eigen::VectorXd> stages() { return {rk.doubles_.K.data(), size()}; }
+    // G's round-off yardstick: the stages' size (G_i = K_i - f(Y_i)).
+    double evaluate(Eigen::Ref<Eigen::VectorXd> G) {
+      rk.assemble(field, h, y0);
+      G = rk.residual_;
+      return stages().lpNorm<Eigen::Infinity>();
+    }
+    void factorize() { rk.lu_.compute(rk.newton_matrix_); }
+    void solve(const Eigen::VectorXd& G, Eigen::VectorXd& update) { update.noalias() = rk.lu_.solve(G); }
+    double apply(const Eigen::VectorXd& update) {
+      stages() -= update;
+      return stages().lpNorm<Eigen::Infinity>();
+    }
+    void finish(const Eigen::VectorXd&) {}
+  };
+
+  // Newton's method on G(K) = 0 from K_i = f(y0), with the stopping rule of every solve of varia.
   void implicit_stages(VectorField& field, double h, const double* y0, StageSolve& report) {
     const int N = field.size(), s = t_.stages();
     auto& K = doubles_.K;
     eval(field, y0, K.data());
     for (int i = 1; i < s; ++i) std::copy(K.begin(), K.begin() + N, K.begin() + i * N);
-    Eigen::Map<Eigen::VectorXd> stages(K.data(), s * N);
-    for (int iteration = 0;; ++iteration) {
-      assemble(field, h, y0);
-      report.iterations = iteration;
-      report.residual = residual_.lpNorm<Eigen::Infinity>();
-      const double scale = 1.0 + stages.lpNorm<Eigen::Infinity>();
-      if (report.residual <= tolerance_ * scale) return;
-      if (iteration == max_iterations_ || !std::isfinite(report.residual)) {
-        report.converged = false;
-        throw std::runtime_error("the implicit stage equations did not converge in " +
-                                 std::to_string(iteration) + " Newton iterations");
-      }
-      lu_.compute(newton_matrix_);
-      update_.noalias() = lu_.solve(residual_);
-      stages -= update_;
-      if (update_.lpNorm<Eigen::Infinity>() <= tolerance_ * scale) {
-        report.iterations = iteration + 1;
-        return;
-      }
-    }
+    StageEquations equations{*this, field, h, y0};
+    const SolveReport solve = newton_.solve(equations);
+    report.iterations = solve.iterations;
+    report.residual = solve.residual;
+    if (solve.converged()) return;
+    report.converged = false;
+    if (solve.outcome == SolveReport::Outcome::non_finite)
+      throw std::runtime_error("the implicit stage equations have a non-finite residual");
+    throw std::runtime_error("the implicit stage equations did not converge in " +
+                             std::to_string(solve.iterations) + " Newton iterations");
   }
 
   // At jets: the stage values by Newton's method on the values, then the implicit function
@@ -257,15 +272,14 @@ class RungeKutta : public OneStepMethod {
   bool explicit_;
   int order_;
   bool self_adjoint_;
-  double tolerance_ = 1e-14;
-  int max_iterations_ = 50;
+  NewtonSolver newton_;
   std::string error_;
   // Workspace, sized on the first step: later steps of the same size allocate nothing.
   Workspace<double> doubles_;
   Workspace<Jet2> jets_;
   std::vector<double> value_point_;
   std::vector<Jet2> residual_jets_;
-  Eigen::VectorXd residual_, update_;
+  Eigen::VectorXd residual_;
   Eigen::MatrixXd newton_matrix_, df_, components_, solution_;
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
 };
