@@ -14,14 +14,13 @@ namespace varia::host {
 namespace {
 
 // Spec "Composed systems": forces enter through the discrete Lagrange-d'Alembert principle, which
-// the galerkin and shooting constructions implement (core/galerkin.hpp, core/shooting.hpp).
+// the constructions that take forces implement (Construction::takes_forces).
 void create_forces(const Scene& scene, Registry& registry, Assembly& a) {
   if (scene.forces.empty()) return;
-  const std::string construction = scene.construction->name();
-  if (construction != "galerkin" && construction != "shooting")
-    throw InputError(fmt::format("/system/forces: forces are taken by constructions 'galerkin' and 'shooting' "
-                                 "only (the discrete Lagrange-d'Alembert principle), not '{}'",
-                                 construction));
+  if (!scene.construction->takes_forces())
+    throw InputError(fmt::format("/system/forces: forces are taken by constructions {} only (the discrete "
+                                 "Lagrange-d'Alembert principle), not '{}'",
+                                 constructions_taking_forces(), scene.construction->name()));
   for (const auto& spec : scene.forces) a.forces.push_back(make_part<Force>(registry, spec, scene, *a.manifold));
 }
 

@@ -397,12 +397,12 @@ std::shared_ptr<PluginObject> Registry::create(const std::string& kind, const st
           .dump();
   char error[1024] = {};
   PluginObject* object = loaded.create(parameter_text.c_str(), context_text.c_str(), error, sizeof error);
-  if (object == nullptr && std::strncmp(error, kRefusedParameter, std::strlen(kRefusedParameter)) == 0)
-    throw InputError(fmt::format("{} (the {} plugin {})", error + std::strlen(kRefusedParameter), type,
-                                 record.file.filename().string()));
-  if (object == nullptr)
+  if (object == nullptr) {
+    if (const char* refused = refused_parameter(error))
+      throw InputError(fmt::format("{} (the {} plugin {})", refused, type, record.file.filename().string()));
     throw PluginLoadError(fmt::format("{}: {}: {}", record.file.string(), type,
                                       error[0] != '\0' ? error : "the plugin made no object"));
+  }
   std::shared_ptr<PluginObject> owned(object, PluginDeleter{loaded.library});
   owned->set_origin(&record);
   if (kind_name(owned->kind()) != kind)

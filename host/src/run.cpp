@@ -165,8 +165,7 @@ class Stepper {
     } catch (const StepFailure& e) {
       failure = Failure{e.step(), e.t(), e.residual(), e.what(), e.origin()};
     } catch (const NumericalFailure& e) {  // an observable that could not be formed
-      failure = observable_failure(e.what(), e.residual());
-      failure->origin = e.origin();
+      failure = observable_failure(e);
     }
     outcome_.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (csv_) csv_->close();
@@ -184,9 +183,9 @@ class Stepper {
   }
 
   // An observable found wrong after its step completed: that step failed, from the time it started at.
-  Failure observable_failure(const std::string& message, double residual) const {
+  Failure observable_failure(const NumericalFailure& e) const {
     const long k = trajectory_.steps();
-    return Failure{k, scene_.t0 + static_cast<double>(std::max(k - 1, 0L)) * scene_.step, residual, message, nullptr};
+    return Failure{k, trajectory_.time_of(std::max(k - 1, 0L)), e.residual(), e.what(), e.origin()};
   }
 
   // Spec "output.every": every k-th step; step 0 and the last step are always written.

@@ -8,7 +8,7 @@
 #include <cmath>
 #include <numeric>
 
-#include "constructions/construction.hpp"
+#include "constructions/parts.hpp"
 #include "registry.hpp"
 
 namespace varia::host {
@@ -112,7 +112,7 @@ PropertyCheck self_adjoint(Context& x) {
 
 PropertyCheck g_invariant(Context& x) {
   const json predicted = prediction(x.predictions.g_invariant);
-  if (std::string(x.a.lagrangian->symmetry_group()) == "none")
+  if (!declares_symmetry(*x.a.lagrangian))
     return not_measured("g_invariant", predicted, "the Lagrangian declares no symmetry group");
   if (x.a.discrete_lagrangian == nullptr)
     return not_measured("g_invariant", predicted, "this construction has no discrete Lagrangian");

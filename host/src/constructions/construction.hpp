@@ -36,6 +36,8 @@ class Construction {
   // Reads the method object (already checked against schema()) into typed options; InputError
   // with the JSON pointer for what a schema cannot say.
   virtual std::shared_ptr<const MethodOptions> read(const nlohmann::json& method) const = 0;
+  // Whether it takes the system's forces (the discrete Lagrange-d'Alembert principle).
+  virtual bool takes_forces() const { return false; }
   // Creates the construction's own plugin objects and the map into `assembly`, whose manifold,
   // Lagrangian and forces are made; InputError (with the pointer) for a composition it cannot
   // serve.
@@ -57,5 +59,7 @@ Scene galerkin_reference(const Scene& scene, int degree, int points);
 // available ones.
 const Construction& construction_named(const std::string& name);
 std::vector<std::string> construction_names();
+// The names of those that take forces, for messages: "'galerkin' and 'shooting'".
+std::string constructions_taking_forces();
 
 }  // namespace varia::host

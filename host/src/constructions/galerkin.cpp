@@ -34,6 +34,7 @@ bool symmetric(const std::vector<double>& d) {
 class Galerkin final : public Construction {
  public:
   const char* name() const override { return "galerkin"; }
+  bool takes_forces() const override { return true; }
 
   json schema() const override {
     return method_schema(

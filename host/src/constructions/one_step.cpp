@@ -30,18 +30,16 @@ class OneStep final : public Construction {
 
   // What the method declares: its order, self-adjointness and symplecticity; a symplectic method
   // that commutes with the symmetry conserves its momentum map (no L_d, no G-invariance claim).
-  Predictions predict(const Scene& scene, const Assembly& a) const override {
-    const DeclaredMethod method = declared(scene, a);
+  Predictions predict(const Scene&, const Assembly& a) const override {
+    const DeclaredMethod method = declared(a);
     Predictions p;
     p.global_order = method.order;
     p.self_adjoint = method.self_adjoint;
     p.symplectic = method.symplectic;
     if (method.symplectic) p.energy_bounded = true;
+    if (declares_symmetry(*a.lagrangian) && method.symplectic && method.equivariant) p.momentum_conserved = true;
     p.reason = "one-step method: its declared order, self-adjointness and symplecticity (no L_d)";
     apply_shared_theorems(a, std::nullopt, p);
-    if (std::string(a.lagrangian->symmetry_group()) != "none" && method.symplectic && method.equivariant &&
-        a.forces.empty())
-      p.momentum_conserved = true;
     return p;
   }
 

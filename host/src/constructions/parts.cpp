@@ -3,7 +3,7 @@
 namespace varia::host {
 
 void apply_shared_theorems(const Assembly& a, std::optional<bool> ld_invariant, Predictions& p) {
-  if (std::string(a.lagrangian->symmetry_group()) != "none") {
+  if (declares_symmetry(*a.lagrangian)) {
     p.g_invariant = ld_invariant;
     if (ld_invariant.value_or(false)) p.momentum_conserved = true;
   }
@@ -21,7 +21,7 @@ void make_one_step(const Scene& scene, Registry& registry, Assembly& a) {
   a.one_step_symplectic = registry.find(scene.one_step->kind, scene.one_step->type).properties.value("symplectic", false);
 }
 
-DeclaredMethod declared(const Scene&, const Assembly& a) {
+DeclaredMethod declared(const Assembly& a) {
   const std::string equivariance = a.one_step->equivariance();
   return DeclaredMethod{a.one_step->order(), a.one_step->self_adjoint(), a.one_step_symplectic,
                         equivariance == "affine" || equivariance == "left"};

@@ -39,6 +39,11 @@ inline std::vector<Force*> forces_of(const Assembly& a) {
   return forces;
 }
 
+// Whether the Lagrangian declares a symmetry group (Noether: a momentum map to conserve).
+inline bool declares_symmetry(const Lagrangian& lagrangian) {
+  return std::string(lagrangian.symmetry_group()) != "none";
+}
+
 // The declared order of a quadrature rule as the theorems use it: its degree of exactness + 1.
 inline int quadrature_order(const Quadrature& rule) { return rule.degree() + 1; }
 
@@ -54,7 +59,7 @@ struct DeclaredMethod {
   bool equivariant = false;
 };
 void make_one_step(const Scene& scene, Registry& registry, Assembly& a);
-DeclaredMethod declared(const Scene& scene, const Assembly& a);
+DeclaredMethod declared(const Assembly& a);
 
 // The theorems every construction shares, applied to its own predictions:
 // - discrete Noether (paper, sec. 1): a G-invariant L_d conserves the discrete momentum map;

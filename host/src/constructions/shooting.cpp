@@ -20,6 +20,7 @@ struct ShootingOptions : MethodOptions {
 class Shooting final : public Construction {
  public:
   const char* name() const override { return "shooting"; }
+  bool takes_forces() const override { return true; }
 
   json schema() const override {
     return method_schema(
@@ -56,7 +57,7 @@ class Shooting final : public Construction {
   // The paper's theorem (sec. 3): order min(p, quadrature order); self-adjoint for a self-adjoint
   // method and a symmetric rule; G-invariant for a G-equivariant method.
   Predictions predict(const Scene& scene, const Assembly& a) const override {
-    const DeclaredMethod method = declared(scene, a);
+    const DeclaredMethod method = declared(a);
     Predictions p;
     p.ld_order = p.global_order = std::min(method.order, quadrature_order(*a.quadrature));
     p.self_adjoint = method.self_adjoint && a.quadrature->symmetric();

@@ -30,6 +30,14 @@ std::vector<std::string> construction_names() {
   return names;
 }
 
+std::string constructions_taking_forces() {
+  std::vector<std::string> names;
+  for (const Construction* c : table())
+    if (c->takes_forces()) names.push_back(fmt::format("'{}'", c->name()));
+  if (names.size() < 2) return fmt::format("{}", fmt::join(names, ""));
+  return fmt::format("{} and {}", fmt::join(names.begin(), names.end() - 1, ", "), names.back());
+}
+
 const Construction& construction_named(const std::string& name) {
   for (const Construction* c : table())
     if (name == c->name()) return *c;

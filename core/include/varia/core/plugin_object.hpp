@@ -7,6 +7,7 @@
 
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace varia {
 
@@ -23,6 +24,11 @@ using Status = const char*;
 // SDK), so that the host reports it as bad input at the parameter's JSON pointer (exit 2) rather
 // than as a plugin fault (exit 3).
 inline constexpr const char* kRefusedParameter = "refused parameter: ";
+// The refusal's own message when a factory's error carries the mark, else null.
+inline const char* refused_parameter(const char* error) {
+  const std::string_view text(error), mark(kRefusedParameter);
+  return text.substr(0, mark.size()) == mark ? error + mark.size() : nullptr;
+}
 
 // The plugin kinds. New kinds are appended; existing ones keep their interfaces.
 enum class Kind { manifold, quadrature, lagrangian, one_step, effect, force };

@@ -37,6 +37,7 @@ class Trajectory {
   const Eigen::VectorXd& q() const { return q_; }
   const Eigen::VectorXd& p() const { return p_; }
   double t() const { return time_of(steps_); }
+  double time_of(long k) const { return t0_ + static_cast<double>(k) * h_; }  // t_k
   long steps() const { return steps_; }  // steps taken so far
   double h() const { return h_; }
 
@@ -57,8 +58,6 @@ class Trajectory {
   }
 
  private:
-  double time_of(long k) const { return t0_ + static_cast<double>(k) * h_; }
-
   DiscreteHamiltonianMap& map_;
   Eigen::VectorXd q_, p_, q1_, p1_;
   double t0_, h_;

@@ -4,7 +4,6 @@
 #pragma once
 
 #include <boost/dll/shared_library.hpp>
-#include <cstring>
 #include <filesystem>
 #include <memory>
 #include <nlohmann/json.hpp>
@@ -47,9 +46,10 @@ class LoadedPlugin {
     char error[512] = "";
     auto& factory = library_->get_alias<CreateFunction>("varia_create");
     PluginObject* object = factory(parameters.dump().c_str(), context.dump().c_str(), error, sizeof error);
-    const std::size_t marker = std::strlen(kRefusedParameter);
-    if (object == nullptr)
-      throw std::runtime_error(std::strncmp(error, kRefusedParameter, marker) == 0 ? error + marker : error);
+    if (object == nullptr) {
+      const char* refused = refused_parameter(error);
+      throw std::runtime_error(refused != nullptr ? refused : error);
+    }
     // Made by the plugin, so typeid and dynamic_cast across the boundary are not to be trusted:
     // the object is T because the plugin's kind says so.
     auto library = library_;
