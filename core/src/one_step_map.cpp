@@ -1,15 +1,15 @@
 #include "varia/core/one_step_map.hpp"
 
-#include "varia/core/rotation_field.hpp"
+#include "varia/core/lie_group_field.hpp"
 
 namespace varia {
 
 namespace {
 
 // The Euler-Lagrange field of the manifold's phase space, y = (q, v).
-std::unique_ptr<EulerLagrangeField> tangent_field(const Manifold& manifold,
+std::unique_ptr<EulerLagrangeField> tangent_field(Manifold& manifold,
                                                   LagrangianEvaluator& lagrangian) {
-  if (!manifold.is_vector_space()) return std::make_unique<RotationField>(manifold, lagrangian);
+  if (!manifold.is_vector_space()) return std::make_unique<LieGroupField>(manifold, lagrangian);
   require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");
   return std::make_unique<MechanicalField>(lagrangian, PhaseSpace::tangent);
 }

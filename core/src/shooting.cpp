@@ -4,8 +4,7 @@
 #include <stdexcept>
 
 #include "varia/core/compensated.hpp"
-
-#include "varia/core/rotation_field.hpp"
+#include "varia/core/lie_group_field.hpp"
 
 namespace varia {
 
@@ -34,14 +33,14 @@ Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingFo
 }
 
 // The Euler-Lagrange field of the manifold's phase space: on R^n in (q, v) or (q, p), with the
-// forces; on a Lie group (TSO(3) = SO(3)-shaped, rotation_field.hpp) in (R, Omega).
-std::unique_ptr<EulerLagrangeField> field_of(const Manifold& manifold, LagrangianEvaluator& lagrangian,
+// forces; on a Lie group in (g, xi) (the Euler-Poincare field, lie_group_field.hpp).
+std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvaluator& lagrangian,
                                             ShootingForm form, Forces& forces) {
   if (manifold.is_vector_space())
     return std::make_unique<MechanicalField>(lagrangian, phase_space(form), &forces);
   if (!forces.empty())
     throw std::invalid_argument("the shooting construction takes forces on vector spaces only");
-  return std::make_unique<RotationField>(manifold, lagrangian);
+  return std::make_unique<LieGroupField>(manifold, lagrangian);
 }
 
 }  // namespace

@@ -10,7 +10,7 @@
 #include "core/so3_reference.hpp"
 #include "varia/core/lie_verlet.hpp"
 #include "varia/core/one_step_map.hpp"
-#include "varia/core/rotation_field.hpp"
+#include "varia/core/lie_group_field.hpp"
 #include "varia/sdk/conformance/loader.hpp"
 #include "varia/sdk/runge_kutta.hpp"
 
@@ -46,13 +46,13 @@ Drift drift(DiscreteHamiltonianMap& map, const Problem& p, double h, long steps)
 
 }  // namespace
 
-// The SDK's Lagrangians evaluate at jets of at most 8 numbers (q, v), and SO(3) has 12: the
-// Jacobian is checked against central differences here, in the test only.
-TEST_CASE("the rotation field's Jacobian is its exact derivative") {
+// The field's Jacobian comes from the field at jets; it is checked against central differences
+// here, in the test only.
+TEST_CASE("the Euler-Poincare field's Jacobian on SO(3) is its exact derivative") {
   Problem p = heavy_top();
   Rotations group;
   LagrangianEvaluator evaluator(p.top);
-  RotationField field(group, evaluator);
+  LieGroupField field(group, evaluator);
   State y = p.start;
   for (int i = 0; i < 3; ++i) y[9 + i] /= p.top.J(i);  // (R, Omega)
   y[4] += 0.01;                                        // off the group, as RK leaves it

@@ -17,7 +17,7 @@
 
 namespace varia {
 
-inline constexpr int kMaxJetVariables = 8;
+inline constexpr int kMaxJetVariables = 12;
 
 struct Jet2 {
   using Gradient = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJetVariables, 1>;
@@ -46,8 +46,8 @@ struct Jet2 {
   Hessian hessian;
 
  private:
-  // Copies whole 64-byte blocks of the fixed-capacity storage (the gradient's 8 numbers, the
-  // Hessian's first n^2 rounded up to 8): constant-size copies the compiler inlines. Eigen copies
+  // Copies whole 64-byte blocks of the fixed-capacity storage (the gradient's kMaxJetVariables
+  // numbers, the Hessian's first n^2 rounded up to 8): constant-size copies the compiler inlines. Eigen copies
   // exactly n and n^2 numbers, by a library call each, which cost more than the copies themselves
   // for the few variables of a jet (a quarter of a shooting step's time went to them).
   void copy_derivatives(const Jet2& other) {
@@ -56,8 +56,8 @@ struct Jet2 {
     hessian.resize(n, n);
     if (n == 0) return;
     constexpr std::size_t block = 8 * sizeof(double);
-    static_assert(kMaxJetVariables * sizeof(double) == block && kMaxJetVariables * kMaxJetVariables % 8 == 0);
-    std::memcpy(gradient.data(), other.gradient.data(), block);
+    static_assert(kMaxJetVariables * kMaxJetVariables % 8 == 0);
+    std::memcpy(gradient.data(), other.gradient.data(), kMaxJetVariables * sizeof(double));
     for (Eigen::Index k = 0; k < n * n; k += 8) std::memcpy(hessian.data() + k, other.hessian.data() + k, block);
   }
 };

@@ -11,6 +11,7 @@
 // templated on the scalar, and the SDK's adapter (varia/sdk/lie_group.hpp) derives these.
 #pragma once
 
+#include "varia/core/jet.hpp"
 #include "varia/core/plugin_object.hpp"
 
 namespace varia {
@@ -57,6 +58,20 @@ class Manifold : public PluginObject {
   // components in the point_size() variables q. On R^n: q - q0.
   virtual Status local_derivatives(const double* /*q0*/, const double* /*q*/, Derivatives /*xi*/) noexcept {
     return "this manifold does not provide its natural chart's inverse to second order";
+  }
+  // The group's action on its points at second-order jets (jet.hpp), for the Lie group one-step
+  // methods and the shooting construction, which propagate (q, xi) with their derivatives
+  // (paper, sec. 3 with sec. 2's Lie group methods): with n = dim(), m = point_size(),
+  //   translate:  q exp(xi), m jets, from q (m jets, a point) and xi (n jets);
+  //   generators: the tangent vectors q e_a of the curves q exp(t e_a) at t = 0, a = 1..n, as the
+  //               m x n matrix D(q) (component-major: D[k n + a]), at jets of q. The Euler-Poincare
+  //               field moves q with velocity D(q) xi and takes the left-trivialized derivative
+  //               of a function f of the point as D(q)^T df/dq.
+  virtual Status translate(const Jet2* /*q*/, const Jet2* /*xi*/, Jet2* /*moved*/) noexcept {
+    return "this manifold does not provide its group's translation at jets";
+  }
+  virtual Status generators(const Jet2* /*q*/, Jet2* /*D*/) noexcept {
+    return "this manifold does not provide its group's generators at jets";
   }
 };
 

@@ -2,9 +2,9 @@
 // "one-step"): the comparison methods of the paper's examples (sec. 3, "Examples": the implicit
 // midpoint rule MID, the 2-stage Gauss method SRK4). (q0, p0) -> (q0, v0 = M^{-1} p0), one step
 // of Psi_h on TQ, then p1 = M v1. Not variational unless the method is symplectic. On R^n the
-// field is the MechanicalField; on SO(3) the RotationField, y = (R, Omega): Runge-Kutta methods
-// integrate it in the embedding R^9 x R^3, Lie group methods on the group (paper, sec. 2,
-// Figure 1: RK, SRK, LGM).
+// field is the MechanicalField; on a Lie group the Euler-Poincare field (lie_group_field.hpp),
+// y = (g, xi): Runge-Kutta methods integrate it in the embedding (R^9 x R^3 on SO(3)), Lie group
+// methods on the group (paper, sec. 2, Figure 1: RK, SRK, LGM).
 #pragma once
 
 #include <Eigen/Core>
@@ -20,8 +20,8 @@ namespace varia {
 
 class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
  public:
-  // Throws std::invalid_argument unless the manifold is a vector space or SO(3), and the
-  // Lagrangian has a constant mass matrix.
+  // Throws std::invalid_argument unless the Lagrangian matches the manifold (a vector space or a
+  // Lie group) and has a constant mass matrix.
   OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian, OneStepMethod& method,
                         SolverOptions options);
   int point_size() const override { return m_; }

@@ -16,7 +16,7 @@ namespace varia {
 // Lie group hooks (algebra, move); 5: Manifold::chart_jets, Manifold::local_jets; 6: the chart's
 // derivatives as caller-sized arrays (Manifold::chart, Manifold::local_derivatives, replacing the
 // jets), Manifold::has_constraint, Lagrangian::evaluates_at_jets, PluginObject::origin.
-inline constexpr int kAbiVersion = 6;
+inline constexpr int kAbiVersion = 7;
 
 using Status = const char*;
 

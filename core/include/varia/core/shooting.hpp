@@ -43,18 +43,18 @@
 // map p1 = p0 (1 - ch/2)/(1 + ch/2) for every exact Psi and rule). Forces are applied in step()
 // only; evaluate() (varia ld) gives the unforced L_d. The time is the step's t0 (discrete_hamiltonian_map.hpp). Not with the type-2 form nor with end-derivative quadratures.
 //
-// On a Lie group (a manifold that is not a vector space; SO(3)-shaped, rotation_field.hpp) the same
+// On a Lie group (a manifold that is not a vector space; the field is lie_group_field.hpp's) the same
 // construction runs in the natural charts (paper, sec. 2 "Natural charts", sec. 3): the jet
 // variables are x = (eta, w0) with q^0 = q0 exp(eta) at eta = 0 (Manifold::chart), the state
-// (R, Omega) propagated by the method with the Euler-Lagrange field on TSO(3) (a Lie group method
-// moves R exp(.)), S = h sum_i b_i L(R^i, Omega^i), and the boundary quantity B = local(q1, R^n)
-// = log(q1^{-1} R^n) (Manifold::local_derivatives), centred at R^n's value in a step. Then G_eta - B_eta^T
+// (g, xi) propagated by the method with the Euler-Poincare field on TG (a Lie group method
+// moves g exp(.)), S = h sum_i b_i L(g^i, xi^i), and the boundary quantity B = local(q1, g^n)
+// = log(q1^{-1} g^n) (Manifold::local_derivatives), centred at g^n's value in a step. Then G_eta - B_eta^T
 // lambda is D1 L_d and lambda = dG/dB at B = 0 is D2 L_d, both left-trivialized: the discrete
 // momenta are body momenta, as lie-verlet's. The lagrangian form only, no forces, no end-derivative
 // quadratures there.
 //
-// Restrictions: a manifold of dimension n <= 4 (jets of 2n <= 8 variables) and a Lagrangian with
-// a constant mass matrix (mechanical_field.hpp).
+// Restrictions: a manifold of dimension n <= 6 (jets of 2n <= kMaxJetVariables = 12 variables:
+// SE(3)) and a Lagrangian with a constant mass matrix (mechanical_field.hpp).
 #pragma once
 
 #include <Eigen/Core>

@@ -7,12 +7,13 @@
 // Derivative vectors have a fixed capacity, so an evaluation allocates nothing; for the common
 // sizes m + n = 2, 4, 6, 12 (Rn of dim 1, 2, 3; SO3) they have a fixed size, so the arithmetic
 // is unrolled and a second-order scalar holds (k+1)^2 doubles instead of 17^2. The same model,
-// evaluated at a dual number over second-order jets, gives gradient_jet (at most
-// kMaxJetInputs = 12 position and velocity numbers together: SO(3)'s 9 + 3).
+// evaluated at dual numbers over second-order jets (kJetDirections derivative directions at a
+// time), gives gradient_jet for every size.
 #pragma once
 
 #include <Eigen/Core>
 #include <string>
+#include <algorithm>
 #include <type_traits>
 #include <unsupported/Eigen/AutoDiff>
 
@@ -22,18 +23,12 @@
 namespace varia::sdk {
 
 inline constexpr int kMaxAutodiffVariables = 18;  // m + n of an autodiff Lagrangian (SE(3): 12 + 6)
-// First derivatives at jet inputs (Lagrangian::gradient_jet): at most kMaxJetInputs numbers
-// m + n (SO(3): 9 + 3), which keeps a Vec of these scalars (12 x 7.9 kB) within Eigen's stack
-// allocation limit (128 kB): a Vec of dual numbers over jets has that capacity, any other Vec
-// kMaxAutodiffVariables.
-inline constexpr int kMaxJetInputs = 12;
+// First derivatives at jet inputs (Lagrangian::gradient_jet) are taken kJetDirections numbers of
+// (q, v) at a time, one evaluation per block: a dual number over jets then holds 1 + 4 jets, and
+// a Vec of them (18 x 5 x 1.3 kB) stays within Eigen's stack allocation limit (128 kB).
+inline constexpr int kJetDirections = 4;
 template <class T>
-inline constexpr int vec_capacity = kMaxAutodiffVariables;
-template <class D>
-inline constexpr int vec_capacity<Eigen::AutoDiffScalar<D>> =
-    std::is_same_v<typename D::Scalar, Jet2> ? kMaxJetInputs : kMaxAutodiffVariables;
-template <class T>
-using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, vec_capacity<T>, 1>;
+using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, kMaxAutodiffVariables, 1>;
 using Dual = Eigen::AutoDiffScalar<Vec<double>>;
 using Dual2 = Eigen::AutoDiffScalar<Vec<Dual>>;
 // The fixed-size counterparts for m + n = K (Eigen's AutoDiffScalar takes any derivative vector).
@@ -41,10 +36,9 @@ template <int K>
 using FixedDual = Eigen::AutoDiffScalar<Eigen::Matrix<double, K, 1>>;
 template <int K>
 using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
-using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, Eigen::Dynamic, 1, 0, kMaxJetInputs, 1>>;
-// Its fixed-size counterpart for m + n = K: K jets per derivative vector, not the capacity's 12.
+// A dual number over jets with K derivative directions.
 template <int K>
-using FixedJetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, K, 1>>;
+using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, K, 1>>;
 
 template <class Model>
 class AutodiffLagrangian : public Lagrangian {
@@ -82,14 +76,9 @@ class AutodiffLagrangian : public Lagrangian {
   bool evaluates_at_jets() const noexcept final { return true; }
   Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final {
     return guarded(error_, [&] {
-      if (m_ + n_ > kMaxJetInputs)
-        throw std::invalid_argument("evaluation at jets takes at most " +
-                                    std::to_string(kMaxJetInputs) +
-                                    " position and velocity numbers together");
-      dispatch([&](auto first, auto, auto) {
-        constexpr int K = decltype(first)::type::DerType::SizeAtCompileTime;
-        jet_first_order<std::conditional_t<K == Eigen::Dynamic, JetDual, FixedJetDual<K>>>(q, v, value, gradient);
-      });
+      if (m_ + n_ <= 2) return jet_first_order<2>(q, v, 0, value, gradient);
+      for (int first = 0; first < m_ + n_; first += kJetDirections)
+        jet_first_order<kJetDirections>(q, v, first, first == 0 ? value : nullptr, gradient);
     });
   }
 
@@ -162,18 +151,23 @@ class AutodiffLagrangian : public Lagrangian {
   }
 #pragma GCC diagnostic pop
 
-  // L (if value is not null) and its gradient at jet inputs: forward mode over the jets, one
-  // derivative direction per number of (q, v); JD is JetDual or, for the common sizes,
-  // FixedJetDual<m + n> (a jet's copy is its value, gradient and Hessian: the dynamic derivative
-  // vector's capacity of 12 made every dual number 12 jets long).
-  template <class JD>
-  void jet_first_order(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) const {
-    const int k = m_ + n_;
+  // L (if value is not null) and the derivatives in the numbers first .. first + K - 1 of (q, v)
+  // (those that exist) at jet inputs: forward mode over the jets, one derivative direction per
+  // number of the block.
+  template <int K>
+  void jet_first_order(const Jet2* q, const Jet2* v, int first, Jet2* value, Jet2* gradient) const {
+    using JD = JetDual<K>;
+    const int k = m_ + n_, last = std::min(first + K, k);
     Vec<JD> qd(m_), vd(n_);
-    for (int i = 0; i < k; ++i) (i < m_ ? qd(i) : vd(i - m_)) = JD(at(q, v, m_, i), k, i);
+    for (int i = 0; i < k; ++i) {
+      JD& z = i < m_ ? qd(i) : vd(i - m_);
+      z.value() = at(q, v, m_, i);
+      z.derivatives().setConstant(Jet2(0.0));
+      if (i >= first && i < last) z.derivatives()(i - first) = Jet2(1.0);
+    }
     const JD r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value();
-    for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : Jet2();
+    for (int i = first; i < last; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i - first) : Jet2();
   }
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).

@@ -15,7 +15,13 @@
 // g exp(t xi)). The adapter derives from them
 //   dexp_{-xi} v = sum_k (-1)^k / (k+1)! ad_xi^k v, the left-trivialized velocity of exp(xi(t))
 //   with xi' = v (the series of (1 - e^{-x}) / x, entire: it converges for every xi);
-//   the coadjoint action ad*_xi mu = (ad_xi)^T mu (coadjoint below).
+//   the coadjoint action ad*_xi mu = (ad_xi)^T mu (coadjoint below);
+//   at jets, the translation q exp(xi) and the generators D(q) e_a = compose(q, e + E_a) - q, with
+//   e = exp(0) and E_a = d exp(t e_a)/dt at t = 0: exact when the composition is affine in its
+//   second factor in the point's numbers, as for a matrix group (SO(3): R1 R2) or a semidirect
+//   product written (R, x) (SE(3): (R1 R2, x1 + R1 x2)). The Lie group conformance suite
+//   (varia/sdk/conformance/manifold.hpp) checks D(q) against retract by a Taylor test, so a group
+//   for which this fails is refused there.
 // Derivatives come from the templated operations evaluated at second-order jets (Jet2). A jet
 // holds at most kMaxJetVariables variables; a quantity of more variables is differentiated in
 // blocks of half that many, one evaluation per pair of blocks (each pair gives its blocks of the
@@ -179,6 +185,23 @@ class LieGroupManifold : public Manifold {
     });
   }
 
+  Status translate(const Jet2* q, const Jet2* xi, Jet2* moved) noexcept override {
+    return guarded(error_, [&] {
+      Group::exp(xi, ys_.data());
+      Group::compose(q, ys_.data(), moved);
+    });
+  }
+
+  Status generators(const Jet2* q, Jet2* D) noexcept override {
+    return guarded(error_, [&] {
+      for (int a = 0; a < n; ++a) {
+        for (int k = 0; k < m; ++k) xs_[k] = Jet2(unit_[k] + tangents_[k * n + a]);
+        Group::compose(q, xs_.data(), ys_.data());
+        for (int k = 0; k < m; ++k) D[k * n + a] = ys_[k] - q[k];
+      }
+    });
+  }
+
   // ad*_xi mu = (ad_xi)^T mu: component j is <mu, [xi, e_j]>.
   static void coadjoint(const double* xi, const double* mu, double* out) {
     double e[n], b[n];
@@ -216,9 +239,28 @@ class LieGroupManifold : public Manifold {
     Group::log(relative, xi);
   }
 
+  // e = exp(0) and E = d exp(xi)/d xi at 0 (m x n, component-major), for generators().
+  static std::array<double, m> unit() {
+    std::array<double, m> e;
+    const double zero[n] = {};
+    Group::exp(zero, e.data());
+    return e;
+  }
+  static std::array<double, m * n> tangents() {
+    std::array<double, m * n> E;
+    std::array<Jet2, std::max(2 * n, m)> xs;
+    std::array<Jet2, std::max(n, m)> ys;
+    const double zero[n] = {};
+    differentiate([](const auto* xi, auto* g) { Group::exp(xi, g); }, zero, n, m, {nullptr, E.data(), nullptr},
+                  xs.data(), ys.data());
+    return E;
+  }
+
   std::array<double, 2 * n> x_{};
   std::array<Jet2, std::max(2 * n, m)> xs_;
   std::array<Jet2, std::max(n, m)> ys_;
+  std::array<double, m> unit_ = unit();
+  std::array<double, m * n> tangents_ = tangents();
 };
 
 }  // namespace varia::sdk

@@ -1,0 +1,175 @@
+#include "varia/core/lie_group_field.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+#include <type_traits>
+
+namespace varia {
+
+namespace {
+
+LagrangianEvaluator& checked(const Manifold& manifold, LagrangianEvaluator& lagrangian) {
+  if (manifold.is_vector_space())
+    throw std::invalid_argument("the Euler-Poincare field is for a Lie group, and the manifold is a vector space");
+  if (lagrangian.position_size() != manifold.point_size() || lagrangian.velocity_size() != manifold.dim())
+    throw std::invalid_argument("the Lagrangian's sizes (" + std::to_string(lagrangian.position_size()) + " + " +
+                                std::to_string(lagrangian.velocity_size()) + ") do not match the manifold's (" +
+                                std::to_string(manifold.point_size()) + " + " + std::to_string(manifold.dim()) + ")");
+  return lagrangian;
+}
+
+}  // namespace
+
+LieGroupField::LieGroupField(Manifold& manifold, LagrangianEvaluator& lagrangian)
+    : EulerLagrangeField(checked(manifold, lagrangian)),
+      manifold_(manifold),
+      m_(manifold.point_size()),
+      generators_(m_ * n_),
+      gradient_(m_ + n_),
+      chart_hessian_(4 * n_ * n_ * n_),
+      point_jet_(m_),
+      generators_jet_(m_ * n_),
+      gradient_jet_(m_ + n_),
+      momentum_jet_(n_),
+      torque_jet_(n_),
+      y_jet_(m_ + n_),
+      f_jet_(m_ + n_),
+      momentum_(n_),
+      torque_(n_) {}
+
+// dexp_{-xi} v = v - 1/2 [xi, v] + O(|xi|^2 |v|): the chart velocity's mixed second derivative
+// in (xi_a, v_b) at 0 is -1/2 [e_a, e_b].
+void LieGroupField::learn_structure(const double* point) {
+  if (!structure_.empty()) return;
+  const std::vector<double> zero(n_, 0.0);
+  check(manifold_, manifold_.chart(point, zero.data(), zero.data(), {}, {nullptr, nullptr, chart_hessian_.data()}),
+        "manifold chart");
+  const int V = 2 * n_;
+  structure_.resize(n_ * n_ * n_);
+  for (int c = 0; c < n_; ++c)
+    for (int a = 0; a < n_; ++a)
+      for (int b = 0; b < n_; ++b)
+        structure_[(c * n_ + a) * n_ + b] = -2.0 * chart_hessian_[(c * V + a) * V + n_ + b];
+}
+
+void LieGroupField::prepare(const double* y) {
+  learn_structure(y);
+  for (int k = 0; k < m_; ++k) point_jet_[k] = Jet2(y[k]);
+  check(manifold_, manifold_.generators(point_jet_.data(), generators_jet_.data()), "manifold generators");
+  for (int i = 0; i < m_ * n_; ++i) generators_[i] = generators_jet_[i].value;
+  lagrangian_.gradient(y, y + m_, gradient_.data());
+}
+
+void LieGroupField::prepare(const Jet2* y) {
+  if (structure_.empty()) {
+    for (int k = 0; k < m_; ++k) generators_[k] = y[k].value;  // the point's values, briefly
+    learn_structure(generators_.data());
+  }
+  check(manifold_, manifold_.generators(y, generators_jet_.data()), "manifold generators");
+  lagrangian_.gradient_jet(y, y + m_, nullptr, gradient_jet_.data());
+}
+
+// g' = D xi;  J xi' = ad*_xi (J xi) + D^T dL/dg, with (ad*_xi mu)_b = sum_{a,c} mu_c xi_a [e_a, e_b]_c.
+template <class T>
+void LieGroupField::rates(const T* y, const T* D, const T* gradient, T* velocity, T* rate) {
+  T* mu;
+  T* torque;
+  if constexpr (std::is_same_v<T, double>) {
+    mu = momentum_.data();
+    torque = torque_.data();
+  } else {
+    mu = momentum_jet_.data();
+    torque = torque_jet_.data();
+  }
+  const T* xi = y + m_;
+  if (velocity != nullptr)
+    for (int k = 0; k < m_; ++k) {
+      T sum(0.0);
+      for (int a = 0; a < n_; ++a) sum += D[k * n_ + a] * xi[a];
+      velocity[k] = sum;
+    }
+  for (int c = 0; c < n_; ++c) {
+    T sum(0.0);
+    for (int b = 0; b < n_; ++b)
+      if (mass_(c, b) != 0.0) sum += mass_(c, b) * xi[b];
+    mu[c] = sum;
+  }
+  for (int b = 0; b < n_; ++b) {
+    T sum(0.0);
+    for (int k = 0; k < m_; ++k) sum += D[k * n_ + b] * gradient[k];
+    for (int c = 0; c < n_; ++c)
+      for (int a = 0; a < n_; ++a) {
+        const double C = structure_[(c * n_ + a) * n_ + b];
+        if (C != 0.0) sum += C * (mu[c] * xi[a]);
+      }
+    torque[b] = sum;
+  }
+  inverse_mass(torque, rate);
+}
+
+Status LieGroupField::eval(const double* y, double* f) noexcept {
+  return guard([&] {
+    prepare(y);
+    rates(y, generators_.data(), gradient_.data(), f, f + m_);
+  });
+}
+
+Status LieGroupField::eval(const Jet2* y, Jet2* f) noexcept {
+  return guard([&] {
+    prepare(y);
+    rates(y, generators_jet_.data(), gradient_jet_.data(), f, f + m_);
+  });
+}
+
+Status LieGroupField::algebra(const double* y, double* xi) noexcept {
+  return guard([&] {
+    std::copy(y + m_, y + m_ + n_, xi);
+    prepare(y);
+    rates(y, generators_.data(), gradient_.data(), static_cast<double*>(nullptr), xi + n_);
+  });
+}
+
+Status LieGroupField::algebra(const Jet2* y, Jet2* xi) noexcept {
+  return guard([&] {
+    std::copy(y + m_, y + m_ + n_, xi);
+    prepare(y);
+    rates(y, generators_jet_.data(), gradient_jet_.data(), static_cast<Jet2*>(nullptr), xi + n_);
+  });
+}
+
+Status LieGroupField::move(const double* y, const double* xi, double* moved) noexcept {
+  return guard([&] {
+    check(manifold_, manifold_.retract(y, xi, moved), "manifold chart");
+    for (int a = 0; a < n_; ++a) moved[m_ + a] = y[m_ + a] + xi[n_ + a];
+  });
+}
+
+Status LieGroupField::move(const Jet2* y, const Jet2* xi, Jet2* moved) noexcept {
+  return guard([&] {
+    check(manifold_, manifold_.translate(y, xi, moved), "manifold translate");
+    for (int a = 0; a < n_; ++a) moved[m_ + a] = y[m_ + a] + xi[n_ + a];
+  });
+}
+
+// Column c of df/dy is the derivative of f in y_c: the field at jets in a block of at most
+// kMaxJetVariables of the state's numbers at a time.
+Status LieGroupField::jacobian(const double* y, double* f, double* df) noexcept {
+  return guard([&] {
+    const int N = m_ + n_;
+    for (int first = 0; first < N; first += kMaxJetVariables) {
+      const int count = std::min(kMaxJetVariables, N - first);
+      for (int i = 0; i < N; ++i)
+        y_jet_[i] = i >= first && i < first + count ? Jet2::variable(y[i], count, i - first) : Jet2(y[i]);
+      prepare(y_jet_.data());
+      rates(y_jet_.data(), generators_jet_.data(), gradient_jet_.data(), f_jet_.data(), f_jet_.data() + m_);
+      for (int r = 0; r < N; ++r) {
+        f[r] = f_jet_[r].value;
+        for (int c = 0; c < count; ++c)
+          df[(first + c) * N + r] = f_jet_[r].constant() ? 0.0 : f_jet_[r].gradient(c);
+      }
+    }
+  });
+}
+
+}  // namespace varia

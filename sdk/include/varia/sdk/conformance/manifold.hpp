@@ -1,0 +1,121 @@
+// The Lie group manifold conformance suite, at a point q the caller gives (the Manifold interface
+// has no distinguished point). Every derivative the constructions use is checked against the
+// manifold's own values (Taylor tests: the error of the first-order model falls as eps^2):
+//   - local is the inverse of retract (the natural chart, paper, sec. 2);
+//   - the generators D(q) (Manifold::generators) are the derivative of retract(q, xi) at 0;
+//   - the chart's point gradient in xi at 0 is D(q), and its velocity gives antisymmetric
+//     structure constants [e_a, e_b] = -[e_b, e_a];
+//   - translate at jets is retract at the values, with derivative D(q) in xi at 0;
+//   - local_derivatives' gradient at q0 = q is a left inverse of D(q).
+// A group whose composition is not affine in its second factor fails the generators' Taylor
+// test (the SDK's adapter derives D(q) from the composition, varia/sdk/lie_group.hpp).
+#pragma once
+
+#include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <vector>
+
+#include "varia/core/manifold.hpp"
+#include "varia/sdk/conformance/failures.hpp"
+
+namespace varia::sdk::conformance {
+
+namespace detail {
+
+inline Eigen::VectorXd retracted(Manifold& manifold, const Eigen::VectorXd& q, const Eigen::VectorXd& xi) {
+  Eigen::VectorXd out(manifold.point_size());
+  if (manifold.retract(q.data(), xi.data(), out.data()) != nullptr) out.setConstant(NAN);
+  return out;
+}
+
+// D(q) at doubles (m x n), NaN where generators fails.
+inline Eigen::MatrixXd generators(Manifold& manifold, const Eigen::VectorXd& q) {
+  const int m = manifold.point_size(), n = manifold.dim();
+  std::vector<Jet2> point(m), D(m * n);
+  for (int k = 0; k < m; ++k) point[k] = Jet2(q[k]);
+  Eigen::MatrixXd out(m, n);
+  if (manifold.generators(point.data(), D.data()) != nullptr) return out.setConstant(NAN);
+  for (int k = 0; k < m; ++k)
+    for (int a = 0; a < n; ++a) out(k, a) = D[k * n + a].value;
+  return out;
+}
+
+}  // namespace detail
+
+// The suite at the point q (a point of the manifold) with random directions from `engine`.
+inline Failures check_lie_group(Manifold& manifold, const Eigen::VectorXd& q, std::mt19937& engine) {
+  Failures failures;
+  const int m = manifold.point_size(), n = manifold.dim();
+  failures.expect(!manifold.is_vector_space(), "the suite is for Lie groups; this manifold is a vector space");
+  failures.expect(q.size() == m && manifold.contains(q.data(), nullptr, 0), "the given point is not on the manifold");
+  if (!failures.empty()) return failures;
+  std::normal_distribution<double> normal;
+  Eigen::VectorXd d(n);
+  for (int a = 0; a < n; ++a) d[a] = normal(engine);
+  d.normalize();
+  const double scale = std::max(1.0, q.lpNorm<Eigen::Infinity>());
+
+  // local(q, retract(q, xi)) = xi.
+  const Eigen::VectorXd xi = 0.3 * d;
+  Eigen::VectorXd back(n);
+  failures.expect(manifold.local(q.data(), detail::retracted(manifold, q, xi).data(), back.data()) == nullptr &&
+                      (back - xi).norm() <= 1e-12,
+                  "local(q, retract(q, xi)) differs from xi by ", (back - xi).norm());
+
+  // Taylor test: |retract(q, eps d) - q - eps D d| falls as eps^2.
+  const Eigen::MatrixXd D = detail::generators(manifold, q);
+  failures.expect(D.allFinite(), "generators() failed or is not finite");
+  if (!failures.empty()) return failures;
+  const auto remainder = [&](double eps) { return (detail::retracted(manifold, q, eps * d) - q - eps * D * d).norm(); };
+  const double slope = std::log2(remainder(1e-2) / remainder(5e-3));
+  failures.expect(std::abs(slope - 2.0) < 0.2, "the generators are not retract's derivative at 0: the first-order ",
+                  "model's error falls as eps^", slope, " (expected eps^2)");
+
+  // The chart's point gradient in xi at 0 is D; its velocity's structure constants are antisymmetric.
+  const int V = 2 * n;
+  std::vector<double> zero(n, 0.0), gradient(m * V), hessian(n * V * V);
+  failures.expect(manifold.chart(q.data(), zero.data(), zero.data(), {nullptr, gradient.data(), nullptr},
+                                 {nullptr, nullptr, hessian.data()}) == nullptr,
+                  "chart() failed");
+  double chart_difference = 0.0, asymmetry = 0.0;
+  for (int k = 0; k < m; ++k)
+    for (int a = 0; a < n; ++a) chart_difference = std::max(chart_difference, std::abs(gradient[k * V + n + a] - D(k, a)));
+  for (int c = 0; c < n; ++c)
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b)
+        asymmetry = std::max(asymmetry, std::abs(hessian[(c * V + a) * V + n + b] + hessian[(c * V + b) * V + n + a]));
+  failures.expect(chart_difference <= 1e-12 * scale, "the chart's gradient in xi at 0 differs from the generators by ",
+                  chart_difference);
+  failures.expect(asymmetry <= 1e-12, "the chart's velocity gives a bracket that is not antisymmetric (by ", asymmetry,
+                  ")");
+
+  // translate at jets: retract at the values, derivative D in xi at 0.
+  std::vector<Jet2> point(m), step(n), moved(m);
+  for (int k = 0; k < m; ++k) point[k] = Jet2(q[k]);
+  for (int a = 0; a < n; ++a) step[a] = Jet2::variable(0.0, n, a);
+  failures.expect(manifold.translate(point.data(), step.data(), moved.data()) == nullptr, "translate() failed");
+  double translate_difference = 0.0;
+  for (int k = 0; k < m; ++k) {
+    translate_difference = std::max(translate_difference, std::abs(moved[k].value - q[k]));
+    for (int a = 0; a < n; ++a)
+      translate_difference =
+          std::max(translate_difference, std::abs((moved[k].constant() ? 0.0 : moved[k].gradient(a)) - D(k, a)));
+  }
+  failures.expect(translate_difference <= 1e-12 * scale, "translate(q, xi) at jets differs from q + D xi + O(xi^2) by ",
+                  translate_difference);
+
+  // d local(q0, q)/dq at q = q0 is a left inverse of D.
+  std::vector<double> local_gradient(n * m);
+  failures.expect(manifold.local_derivatives(q.data(), q.data(), {nullptr, local_gradient.data(), nullptr}) == nullptr,
+                  "local_derivatives() failed");
+  const Eigen::MatrixXd left = Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>>(
+                                   local_gradient.data(), n, m) * D;
+  failures.expect((left - Eigen::MatrixXd::Identity(n, n)).lpNorm<Eigen::Infinity>() <= 1e-12 * scale,
+                  "local_derivatives' gradient is not a left inverse of the generators (off by ",
+                  (left - Eigen::MatrixXd::Identity(n, n)).lpNorm<Eigen::Infinity>(), ")");
+  return failures;
+}
+
+}  // namespace varia::sdk::conformance

@@ -1,0 +1,86 @@
+// The Lie group manifold conformance suite (varia/sdk/conformance/manifold.hpp) on the bundled
+// groups, at random points, and on a group that breaks the SDK adapter's hypothesis (a
+// composition that is not affine in its second factor), which it must refuse.
+#include <doctest/doctest.h>
+
+#include <random>
+
+#include "load_plugin.hpp"
+#include "varia/sdk/conformance/manifold.hpp"
+#include "varia/sdk/lie_group.hpp"
+
+namespace {
+
+using nlohmann::json;
+using varia::test::load_plugin;
+
+// Random points g = g0 exp(xi) of the manifold, from a point g0 on it.
+Eigen::VectorXd random_point(varia::Manifold& manifold, const Eigen::VectorXd& g0, std::mt19937& engine) {
+  std::normal_distribution<double> normal;
+  Eigen::VectorXd xi(manifold.dim()), g(manifold.point_size());
+  for (auto& x : xi) x = normal(engine);
+  REQUIRE(manifold.retract(g0.data(), xi.data(), g.data()) == nullptr);
+  return g;
+}
+
+// R under addition, embedded as (x, x^3): a Lie group whose composition (a, b) -> (a0 + b0,
+// (a0 + b0)^3) is not affine in b, so compose(q, e + E) - q is not the tangent vector.
+struct Cubic {
+  static constexpr int point_size = 2, dim = 1;
+  template <class T>
+  static void compose(const T* a, const T* b, T* ab) {
+    ab[0] = a[0] + b[0];
+    ab[1] = ab[0] * ab[0] * ab[0];
+  }
+  static void inverse(const double* a, double* a_inverse) {
+    a_inverse[0] = -a[0];
+    a_inverse[1] = -a[1];
+  }
+  template <class T>
+  static void exp(const T* xi, T* g) {
+    g[0] = xi[0];
+    g[1] = xi[0] * xi[0] * xi[0];
+  }
+  template <class T>
+  static void log(const T* g, T* xi) {
+    xi[0] = g[0];
+  }
+  template <class T>
+  static void bracket(const T*, const T*, T* ab) {
+    ab[0] = T(0.0);
+  }
+};
+
+class CubicLine final : public varia::sdk::LieGroupManifold<Cubic> {
+ public:
+  bool contains(const double* q, char*, int) noexcept override { return std::abs(q[1] - q[0] * q[0] * q[0]) < 1e-12; }
+};
+
+}  // namespace
+
+TEST_CASE("the Lie group conformance suite passes SO3 and SE3 at random points, with the generators' Taylor test") {
+  std::mt19937 engine(20261124);
+  const Eigen::VectorXd rotation = (Eigen::VectorXd(9) << 1, 0, 0, 0, 1, 0, 0, 0, 1).finished();
+  const Eigen::VectorXd motion = (Eigen::VectorXd(12) << 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.3, -2, 5).finished();
+  for (const auto& [type, identity] : {std::pair{"SO3", rotation}, std::pair{"SE3", motion}}) {
+    CAPTURE(type);
+    auto file = load_plugin("manifold", type);
+    auto manifold = file.create<varia::Manifold>(json::object(), json::object());
+    for (int trial = 0; trial < 5; ++trial) {
+      const auto failures = varia::sdk::conformance::check_lie_group(*manifold, random_point(*manifold, identity, engine), engine);
+      for (const auto& failure : failures.list()) FAIL_CHECK(failure);
+      CHECK(failures.empty());
+    }
+  }
+}
+
+TEST_CASE("the Lie group conformance suite refuses a group whose composition is not affine in its second factor") {
+  std::mt19937 engine(7);
+  CubicLine line;
+  const Eigen::Vector2d q(0.7, 0.343);
+  const auto failures = varia::sdk::conformance::check_lie_group(line, q, engine);
+  REQUIRE_FALSE(failures.empty());
+  bool names_generators = false;
+  for (const auto& failure : failures.list()) names_generators |= failure.find("generators") != std::string::npos;
+  CHECK(names_generators);
+}
