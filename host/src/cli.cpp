@@ -222,6 +222,10 @@ int main_cli(int argc, char** argv) {
   open_standard_descriptors();
   install_interrupt_handlers();
   install_crash_handlers();
+  return run_command_line(argc, argv, [](const std::string&) { return true; });
+}
+
+int run_command_line(int argc, char** argv, const std::function<bool(const std::string&)>& runs) {
   CLI::App app{"varia: variational integrators built from runtime-loaded plugins."};
   app.set_version_flag("--version", VARIA_VERSION);
   app.require_subcommand(1);
@@ -243,7 +247,12 @@ int main_cli(int argc, char** argv) {
     report(e.what());  // spec "Exit codes": a bad flag is bad input
     return kExitInput;
   }
-  return guarded(chosen);
+  if (!runs(app.get_subcommands().front()->get_name())) return kExitOk;
+  const CommandInFlight running;  // from here an exit() is a plugin's (crash.hpp)
+  return guarded([&] {
+    keep_stdout_for_results();
+    return chosen();
+  });
 }
 
 }  // namespace varia::host

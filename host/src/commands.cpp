@@ -92,19 +92,19 @@ void print_plugins_table(const std::vector<PluginRecord>& records, const std::ve
   }
   const auto line = [&](const std::string& kind, const std::string& type, const std::string& version,
                         const std::string& file) {
-    fmt::print("{:<{}}  {:<{}}  {:<{}}  {}\n", kind, kind_width, type, type_width, version, version_width, file);
+    fmt::print(results(), "{:<{}}  {:<{}}  {:<{}}  {}\n", kind, kind_width, type, type_width, version, version_width, file);
   };
   line("KIND", "TYPE", "VERSION", "FILE");
   const std::string indent(kind_width + 2, ' ');
   for (const auto& r : records) {
     line(r.kind, r.type, r.version, r.file.string());
-    fmt::print("{}parameters: {}\n", indent, parameters_text(r.parameter_schema));
+    fmt::print(results(), "{}parameters: {}\n", indent, parameters_text(r.parameter_schema));
     if (const auto properties = properties_text(r.properties); !properties.empty())
-      fmt::print("{}properties: {}\n", indent, properties);
+      fmt::print(results(), "{}properties: {}\n", indent, properties);
   }
   if (refused.empty()) return;
-  fmt::print("\nrefused:\n");
-  for (const auto& r : refused) fmt::print("  {}: {}\n", r.file.string(), r.reason);
+  fmt::print(results(), "\nrefused:\n");
+  for (const auto& r : refused) fmt::print(results(), "  {}: {}\n", r.file.string(), r.reason);
 }
 
 nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records) {
@@ -159,7 +159,7 @@ int command_plugins(const CommonOptions& common, bool as_json) {
     print_plugins_table(records, refused);
     return 0;
   }
-  fmt::print("{}\n", plugins_json(records).dump(2));
+  fmt::print(results(), "{}\n", plugins_json(records).dump(2));
   // With --json, stdout holds the array alone; refusals are diagnostics on stderr.
   for (const auto& r : refused) fmt::print(stderr, "varia: refused {}: {}\n", r.file.string(), r.reason);
   return 0;
@@ -168,7 +168,7 @@ int command_plugins(const CommonOptions& common, bool as_json) {
 int command_validate(const CommonOptions& common, const std::string& scene_file) {
   return with_registry(common, [&](Registry& registry) {
     const Prepared prepared = prepare(scene_file, registry);
-    fmt::print("{}: valid ({} with {} on {}, {} steps of {})\n", scene_file, prepared.scene.construction->name(),
+    fmt::print(results(), "{}: valid ({} with {} on {}, {} steps of {})\n", scene_file, prepared.scene.construction->name(),
                prepared.scene.lagrangian.type, prepared.scene.manifold.type, prepared.scene.steps,
                prepared.scene.step);
     return 0;
@@ -210,10 +210,10 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
                              std::nan(""));
     if (options.json) {
       const nlohmann::ordered_json result{{"Ld", ld}, {"D1", as_vector(d1)}, {"D2", as_vector(d2)}};
-      fmt::print("{}\n", result.dump());
+      fmt::print(results(), "{}\n", result.dump());
       return 0;
     }
-    fmt::print("Ld = {}\nD1 = [{}]\nD2 = [{}]\n", ld, fmt::join(as_vector(d1), ", "),
+    fmt::print(results(), "Ld = {}\nD1 = [{}]\nD2 = [{}]\n", ld, fmt::join(as_vector(d1), ", "),
                fmt::join(as_vector(d2), ", "));
     return 0;
   });
@@ -224,7 +224,7 @@ int command_verify(const CommonOptions& common, const std::string& scene_file, c
   return with_registry(common, [&](Registry& registry) {
     Prepared prepared = prepare(scene_file, registry);
     const auto checks = verify_scene(prepared.scene, prepared.assembly, registry);
-    fmt::print("{}", checks_table(checks));
+    fmt::print(results(), "{}", checks_table(checks));
     if (!json_file.empty()) write_json_file(json_file, nlohmann::ordered_json(checks_json(checks)), "--json");
     const long failures = std::count_if(checks.begin(), checks.end(), [](const auto& c) { return c.failed(); });
     if (failures == 0) return 0;

@@ -308,16 +308,16 @@ void write_plot(const std::filesystem::path& file, const std::deque<Method>& met
 }
 
 void print_table(const Method& m) {
-  fmt::print("{} ({}): predicted order {}, fitted slope {}\n  error measured against the {}\n", m.name, m.file,
+  fmt::print(results(), "{} ({}): predicted order {}, fitted slope {}\n  error measured against the {}\n", m.name, m.file,
              m.predicted_order, m.fit.used >= 2 ? fmt::format("{:.2f} ({} points)", m.fit.slope, m.fit.used) : "-",
              m.truth->source);
-  fmt::print("  {:>10} {:>8} {:>11} {:>11} {:>10} {:>11} {:>11}\n", "h", "steps", "error", "energy err", "seconds",
+  fmt::print(results(), "  {:>10} {:>8} {:>11} {:>11} {:>10} {:>11} {:>11}\n", "h", "steps", "error", "energy err", "seconds",
              "Newton/step", "evals/step");
   for (const Row& r : m.rows)
-    fmt::print("  {:>10.4g} {:>8} {:>11.3e} {:>11.3e} {:>10.3e} {:>11.2f} {:>11.2f}\n", r.h, r.steps, r.error,
+    fmt::print(results(), "  {:>10.4g} {:>8} {:>11.3e} {:>11.3e} {:>10.3e} {:>11.2f} {:>11.2f}\n", r.h, r.steps, r.error,
                r.energy_error, r.seconds, static_cast<double>(r.newton_iterations) / r.steps,
                static_cast<double>(r.evaluations) / r.steps);
-  for (const auto& why : m.fit.dropped) fmt::print("  not fitted: {}\n", why);
+  for (const auto& why : m.fit.dropped) fmt::print(results(), "  not fitted: {}\n", why);
 }
 
 }  // namespace
@@ -368,7 +368,7 @@ int command_cost(const CommonOptions& common, const std::vector<std::string>& sc
   write_csv(options.out / "cost.csv", methods);
   write_json_file(options.out / "cost.json", record, "--out");
   write_plot(options.out / "cost.svg", methods);
-  if (!options.quiet) fmt::print("wrote {}, cost.svg, cost.json\n", (options.out / "cost.csv").string());
+  if (!options.quiet) fmt::print(results(), "wrote {}, cost.svg, cost.json\n", (options.out / "cost.csv").string());
   return 0;
 }
 

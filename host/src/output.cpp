@@ -12,6 +12,7 @@
 
 #include <fmt/ranges.h>
 
+#include "crash.hpp"
 #include "errors.hpp"
 
 namespace varia::host {
@@ -21,6 +22,8 @@ namespace fs = std::filesystem;
 namespace {
 
 constexpr std::size_t kFlushBytes = 1 << 16;  // write to the file in chunks of whole rows
+
+std::FILE* results_stream = nullptr;  // keep_stdout_for_results()
 
 // Writes all of `text` to `fd` (retrying short writes and interrupted calls); false with errno set
 // when the system refuses part of it, `done` then telling how much it took.
@@ -118,8 +121,14 @@ bool same_file(const fs::path& a, const fs::path& b) {
 }  // namespace
 
 CsvWriter::CsvWriter(const fs::path& file) : name_(file.string()) {
+  open(file);
+  watch_trajectory(this);
+}
+
+void CsvWriter::open(const fs::path& file) {
   if (file == "-") {
-    fd_ = STDOUT_FILENO;
+    std::fflush(results());
+    fd_ = ::fileno(results());
     return;
   }
   // Not truncated on opening: a file that another run is writing is refused before it is touched.
@@ -145,6 +154,7 @@ CsvWriter::CsvWriter(const fs::path& file) : name_(file.string()) {
 }
 
 CsvWriter::~CsvWriter() {
+  watch_trajectory(nullptr);
   if (fd_ < 0) return;
   try {
     flush();
@@ -176,18 +186,33 @@ void CsvWriter::end_row() {
 void CsvWriter::flush() {
   if (failed_ || buffer_.size() == 0) return;
   const std::string_view rows(buffer_.data(), buffer_.size());
+  int error = 0;
+  const bool written = write_rows(rows, error);
   buffer_.clear();
-  std::size_t done = 0;
-  if (!write_all(fd_, rows, done)) {
-    const int error = errno;
-    failed_ = true;
-    // A row cut part-way is taken back: the file keeps the whole rows that reached it.
-    const auto last_newline = rows.substr(0, done).rfind('\n');
-    if (regular_) (void)::ftruncate(fd_, whole_ + (last_newline == std::string_view::npos ? 0 : static_cast<off_t>(last_newline + 1)));
+  if (!written)
     throw OutputError(fmt::format("--out {}: cannot be written: {}; it ends with the last whole row written",
                                   name_, std::strerror(error)));
+}
+
+bool CsvWriter::write_rows(std::string_view rows, int& error) noexcept {
+  std::size_t done = 0;
+  if (write_all(fd_, rows, done)) {
+    whole_ += static_cast<off_t>(rows.size());
+    return true;
   }
-  whole_ += static_cast<off_t>(rows.size());
+  error = errno;
+  failed_ = true;
+  // A row cut part-way is taken back: the file keeps the whole rows that reached it.
+  const auto last_newline = rows.substr(0, done).rfind('\n');
+  if (regular_) (void)::ftruncate(fd_, whole_ + (last_newline == std::string_view::npos ? 0 : static_cast<off_t>(last_newline + 1)));
+  return false;
+}
+
+void CsvWriter::write_whole_rows() noexcept {
+  if (fd_ < 0 || failed_) return;
+  const auto last_newline = std::string_view(buffer_.data(), buffer_.size()).rfind('\n');
+  int error = 0;
+  if (last_newline != std::string_view::npos) (void)write_rows({buffer_.data(), last_newline + 1}, error);
 }
 
 void CsvWriter::close() {
@@ -199,7 +224,7 @@ void CsvWriter::close() {
 
 void write_output(const fs::path& file, std::string_view text, std::string_view what) {
   if (file == "-") {
-    if (std::fwrite(text.data(), 1, text.size(), stdout) != text.size() || std::fflush(stdout) != 0)
+    if (std::fwrite(text.data(), 1, text.size(), results()) != text.size() || std::fflush(results()) != 0)
       fail(what, "(stdout)", "written", errno);
     return;
   }
@@ -214,8 +239,22 @@ void write_json_file(const fs::path& file, const nlohmann::ordered_json& documen
   write_output(file, document.dump(2) + "\n", what);
 }
 
+std::FILE* results() { return results_stream != nullptr ? results_stream : stdout; }
+
+void keep_stdout_for_results() {
+  if (results_stream != nullptr || std::fflush(stdout) != 0) return;
+  const int kept = ::fcntl(STDOUT_FILENO, F_DUPFD_CLOEXEC, 3);
+  std::FILE* stream = kept < 0 ? nullptr : ::fdopen(kept, "w");
+  if (stream == nullptr || ::dup2(STDERR_FILENO, STDOUT_FILENO) < 0) {
+    if (stream != nullptr) std::fclose(stream);
+    else if (kept >= 0) ::close(kept);
+    throw OutputError(fmt::format("stdout cannot be kept apart from what plugins print: {}", std::strerror(errno)));
+  }
+  results_stream = stream;
+}
+
 void check_stdout() {
-  if (std::fflush(stdout) != 0 || std::ferror(stdout))
+  if (std::fflush(results()) != 0 || std::ferror(results()))
     throw OutputError(fmt::format("stdout: the results cannot be written: {}", std::strerror(errno)));
 }
 

@@ -8,6 +8,7 @@
 #include <sys/types.h>
 
 #include <Eigen/Core>
+#include <cstdio>
 #include <filesystem>
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
@@ -19,7 +20,7 @@ namespace varia::host {
 
 class CsvWriter {
  public:
-  // "-" writes to stdout. A regular file is locked for the run: a second run writing the same
+  // "-" writes to stdout (results()). A regular file is locked for the run: a second run writing the same
   // file is refused (OutputError) before it truncates it. Throws OutputError when the file
   // cannot be opened.
   explicit CsvWriter(const std::filesystem::path& file);
@@ -36,9 +37,16 @@ class CsvWriter {
   void flush();
   // flush(), then closes the file, checked.
   void close();
+  // Writes the buffered whole rows, reporting nothing: for the crash handlers (crash.hpp), when a
+  // plugin ends the process. It only calls write(2) and ftruncate(2), which are async-signal-safe.
+  void write_whole_rows() noexcept;
 
  private:
+  void open(const std::filesystem::path& file);
   void end_row();
+  // Writes `rows` (whole rows); false with the error when the system refuses part of it, the file
+  // then cut back to its last whole row.
+  bool write_rows(std::string_view rows, int& error) noexcept;
   std::string name_;
   int fd_ = -1;
   bool owned_ = false, regular_ = false, failed_ = false;
@@ -57,7 +65,17 @@ void write_output(const std::filesystem::path& file, std::string_view text, std:
 void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_json& document,
                      std::string_view what = "output");
 
-// Flushes and checks stdout: results written there that did not arrive are an OutputError.
+// Where results meant for stdout go (spec: "results go to files or stdout"): stdout itself, or,
+// after keep_stdout_for_results(), a stream of its own on the real stdout.
+std::FILE* results();
+
+// Keeps stdout for results: the real stdout is duplicated for results(), and descriptor 1 (with
+// the C library's stdout and std::cout, which plugins share with varia) is pointed at stderr, so
+// that what plugins print goes to stderr and cannot corrupt a CSV or a JSON document on stdout
+// (docs/security.md). Called once, before any plugin is loaded.
+void keep_stdout_for_results();
+
+// Flushes and checks results(): results written there that did not arrive are an OutputError.
 void check_stdout();
 
 // A file a command reads or writes, as named on its command line ("-": stdin or stdout).

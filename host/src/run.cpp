@@ -262,7 +262,7 @@ void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry,
                                        failure->t, failure->message, failure->residual),
                            failure->residual, failure->origin);
   // With the trajectory on stdout, the human summary goes to stderr.
-  if (!options.quiet) print_human_summary(options.out && *options.out == "-" ? stderr : stdout, scene, assembly,
+  if (!options.quiet) print_human_summary(options.out && *options.out == "-" ? stderr : results(), scene, assembly,
                                           stepper.observer(), stepper.state(), stepper.outcome());
 }
 

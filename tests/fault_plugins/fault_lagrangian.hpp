@@ -24,3 +24,29 @@ class FaultLagrangian : public sdk::AutodiffLagrangian<Model> {
 };
 
 }  // namespace varia::test
+
+namespace varia::test {
+
+// The oscillator until its evaluation number `after` (a parameter, 0 by default), which runs
+// Model::fault() (a crash, an exit): a run then has rows written, and rows buffered, before it.
+template <class Model>
+class FaultAfter : public FaultLagrangian<Model> {
+ public:
+  static constexpr const char* parameter_schema =
+      R"({"type": "object", "properties": {"after": {"type": "integer", "minimum": 0, "default": 0}},
+          "additionalProperties": false})";
+
+  explicit FaultAfter(const nlohmann::json& parameters) : after_(parameters.value("after", 0L)) {}
+
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    if (evaluations_++ == after_) Model::fault();
+    return FaultLagrangian<Model>::oscillator(q, v);
+  }
+
+ private:
+  long after_;
+  mutable long evaluations_ = 0;
+};
+
+}  // namespace varia::test

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Builds the scene fuzzer with clang (tests/fuzz/CMakeLists.txt) and runs it for a bounded time,
-# seeded with every scene of scenes/ (good and bad) and the regressions of tests/fuzz/regressions.
+# Builds the fuzzer with clang (tests/fuzz/CMakeLists.txt) and runs it for a bounded time, seeded
+# with every scene of scenes/ (good and bad) and the regressions of tests/fuzz/regressions (plugin
+# parameter schemas, command lines). What varia prints is dropped (-close_fd_mask=3); libFuzzer's
+# report and the sanitizers' go to BUILD_DIR/fuzz/fuzz.log.
 # Usage: run.sh BUILD_DIR SOURCE_DIR CLANGXX SECONDS. Exits 77 (ctest: skipped) when libFuzzer
 # cannot be built here; non-zero when the fuzzer finds a crash, which it writes to
 # BUILD_DIR/fuzz/findings/ (turn each into a regression: scenes/bad/ or tests/fuzz/regressions/).
@@ -8,7 +10,7 @@ set -euo pipefail
 build=$1 source=$2 clangxx=$3 seconds=$4
 fuzz=$build/fuzz
 if ! cmake -S "$source/tests/fuzz" -B "$fuzz/build" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
-  -DCMAKE_CXX_COMPILER="$clangxx" -DVARIA_PLUGIN_DIR="$build/lib/varia/plugins" >"$fuzz.configure.log" 2>&1; then
+  -DCMAKE_CXX_COMPILER="$clangxx" -DVARIA_PLUGIN_DIR="$build/lib/varia/plugins" -DVARIA_CORE_LIBRARY="$build/core/libvaria_core.a" >"$fuzz.configure.log" 2>&1; then
   echo "fuzz: skipped, libFuzzer cannot be built here (see $fuzz.configure.log)"
   exit 77
 fi
@@ -17,7 +19,10 @@ corpus=$fuzz/corpus
 mkdir -p "$corpus" "$fuzz/findings"
 find "$source/scenes" "$source/tests/fuzz/regressions" -name '*.json' -exec cp {} "$corpus/" \; 2>/dev/null || true
 cp "$source"/tests/fuzz/regressions/* "$corpus/" 2>/dev/null || true
+export VARIA_FUZZ_SANDBOX=$fuzz/sandbox  # where the command lines run
+rm -rf "$VARIA_FUZZ_SANDBOX"
+trap 'rm -rf "$VARIA_FUZZ_SANDBOX"' EXIT
 "$fuzz/build/scene_fuzzer" -max_total_time="$seconds" -max_len=65536 -timeout=10 -rss_limit_mb=4096 \
-  -dict="$source/tests/fuzz/scene.dict" -artifact_prefix="$fuzz/findings/" -print_final_stats=1 \
+  -dict="$source/tests/fuzz/scene.dict" -close_fd_mask=3 -artifact_prefix="$fuzz/findings/" -print_final_stats=1 \
   "$corpus" 2>"$fuzz/fuzz.log" || { tail -40 "$fuzz/fuzz.log"; exit 1; }
-grep -E "stat::number_of_executed_units|Done" "$fuzz/fuzz.log" || true
+grep -E "stat::number_of_executed_units|stat::peak_rss_mb|Done" "$fuzz/fuzz.log" || true

@@ -206,18 +206,119 @@ TEST_CASE("a plugin whose type no scene names is never loaded, stripped or not")
   }
 }
 
-TEST_CASE("a plugin that crashes varia is named on stderr") {
+// The lines of stderr that varia wrote (a shell that ran it may add its own, e.g. "Aborted").
+std::vector<std::string> varia_lines(const std::string& err) {
+  std::vector<std::string> lines;
+  for (auto& line : lines_of(err))
+    if (line.rfind("varia:", 0) == 0) lines.push_back(std::move(line));
+  return lines;
+}
+
+TEST_CASE("a plugin that crashes varia while it is loaded is named on stderr, exit 3") {
   TempDir dir;
   fs::copy_file(fs::path(VARIA_ABORTING_PLUGIN_DIR) / "fault_aborts_on_load.so", dir / "fault_aborts_on_load.so");
   const auto outcome = run_varia("plugins --plugin-path '" + dir.path().string() + "'");
-  CHECK(outcome.code != 0);
-  // One line from varia (the shell that ran it may add its own "Aborted" after it).
-  const auto lines = lines_of(outcome.err);
   CAPTURE(outcome.err);
-  REQUIRE(!lines.empty());
-  CHECK(std::count_if(lines.begin(), lines.end(), [](const std::string& l) { return l.rfind("varia:", 0) == 0; }) == 1);
-  CHECK(contains(lines[0], "varia: error: plugin fault: fatal signal SIGABRT (abort) in a call to the plugin "));
-  CHECK(contains(lines[0], "fault_aborts_on_load.so"));
+  CHECK(outcome.code == 3);
+  const auto lines = varia_lines(outcome.err);
+  REQUIRE(lines.size() == 1);
+  CHECK(contains(lines[0], "varia: error: plugin fault: fatal signal SIGABRT (abort) in a call to the plugin " +
+                               (dir / "fault_aborts_on_load.so").string() + "; varia ends with exit code 3"));
+  CHECK(outcome.out.empty());
+}
+
+// The default scene over 4,000 steps (6 evaluations each) with a fault plugin of tests/fault_plugins as its Lagrangian,
+// faulting at its evaluation number `after`.
+fs::path scene_faulting_after(const TempDir& dir, const std::string& type, long after) {
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
+  scene["system"]["lagrangian"] = {{"type", type}, {"after", after}};
+  scene.erase("t_end");
+  scene["steps"] = 4000;
+  const auto file = dir / (type + "-" + std::to_string(after) + ".json");
+  write_file(file, scene.dump());
+  return file;
+}
+
+struct CrashCase {
+  const char* type;
+  const char* file;
+  const char* what;  // in the one line that names the file
+};
+
+// Spec "Exit codes": 3 for a plugin fault, the file named; the trajectory written so far whole. A
+// fatal signal or an exit cannot be recovered from: the process ends with code 3 (crash.hpp).
+TEST_CASE("a plugin that crashes, overflows its stack or exits mid-run is named, exit 3, output whole rows") {
+  const FaultDirectory faults;
+  const CrashCase cases[] = {
+      {"fault-segfault", "fault_segfaults.so", "fatal signal SIGSEGV"},
+      {"fault-abort", "fault_aborts.so", "fatal signal SIGABRT (abort)"},
+      {"fault-stack-overflow", "fault_overflows_stack.so", "fatal signal SIGSEGV"},
+      {"fault-exit", "fault_exits.so", "called exit or quick_exit during the command"},
+      {"fault-quick-exit", "fault_quick_exits.so", "called exit or quick_exit during the command"},
+  };
+  // What the same oscillator writes when it does not fault: the rows a faulting run must begin with.
+  const auto whole = run_varia("run '" + scene_faulting_after(faults.dir, "fault-exit", 1L << 40).string() +
+                               "' --out - --quiet " + faults.flag());
+  REQUIRE(whole.code == 0);
+  const auto whole_rows = lines_of(whole.out);
+  REQUIRE(whole_rows.size() == 4002);
+  for (const auto& c : cases) {
+    // Early (every row still in the writer's buffer) and late (after chunks reached the file).
+    for (const long after : {300L, 18000L}) {
+      for (const std::string& out : {std::string("-"), (faults.dir / "t.csv").string()}) {
+        CAPTURE(c.type);
+        CAPTURE(after);
+        CAPTURE(out);
+        const auto summary = faults.dir / "run.json";
+        fs::remove(summary);
+        const auto outcome = run_varia("run '" + scene_faulting_after(faults.dir, c.type, after).string() +
+                                       "' --out '" + out + "' --summary '" + summary.string() + "' --quiet " +
+                                       faults.flag());
+        CAPTURE(outcome.err);
+        CHECK(outcome.code == 3);
+        const auto lines = varia_lines(outcome.err);
+        REQUIRE(lines.size() == 1);
+        CHECK(contains(lines[0], "varia: error: plugin fault: "));
+        CHECK(contains(lines[0], c.what));
+        CHECK(contains(lines[0], (faults.dir / c.file).string()));
+        const std::string csv = out == "-" ? outcome.out : read_file(out);
+        if (out != "-") CHECK(outcome.out.empty());
+        // Whole rows, the same as the run without the fault, as many as were computed: the rows the
+        // writer still held are written too.
+        REQUIRE(!csv.empty());
+        CHECK(csv.back() == '\n');
+        const auto rows = lines_of(csv);
+        CHECK(rows.size() >= 2);
+        CHECK(rows.size() < whole_rows.size());
+        for (std::size_t i = 0; i < rows.size() && i < whole_rows.size(); ++i) REQUIRE(rows[i] == whole_rows[i]);
+        CHECK_FALSE(fs::exists(summary));
+      }
+    }
+  }
+}
+
+TEST_CASE("what a plugin prints goes to stderr: stdout holds the results alone") {
+  const FaultDirectory faults;
+  const auto scene = scene_with_lagrangian(faults.dir, "fault-printf");
+  const auto run = run_varia("run '" + scene.string() + "' --out - --quiet " + faults.flag());
+  CAPTURE(run.err);
+  CHECK(run.code == 0);
+  CHECK(contains(run.err, "prints plugin: printf in the first evaluation"));
+  CHECK(contains(run.err, "prints plugin: write(1)"));
+  const auto rows = lines_of(run.out);
+  REQUIRE(rows.size() == 202);
+  CHECK(rows[0] == "t,q0,p0");
+  for (const auto& row : rows) CHECK(std::count(row.begin(), row.end(), ',') == 2);
+
+  const auto ld = run_varia("ld '" + scene.string() + "' --q0 0.1 --q1 0.2 --h 0.1 --json " + faults.flag());
+  CHECK(ld.code == 0);
+  CHECK(contains(ld.err, "prints plugin: std::cout in the constructor"));
+  CHECK(json::parse(ld.out).contains("Ld"));
+
+  const auto listing = run_varia("plugins --json " + faults.flag());
+  CHECK(listing.code == 0);
+  CHECK(contains(listing.err, "prints plugin: puts"));
+  CHECK(json::parse(listing.out).is_array());
 }
 
 }  // namespace
