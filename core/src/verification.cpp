@@ -87,7 +87,29 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
     kept.pop_back();
   }
   fit.used = static_cast<int>(kept.size());
-  if (fit.fitted()) fit.slope = log_log_slope(h, error, kept);
+  if (!fit.fitted()) return fit;
+  fit.slope = log_log_slope(h, error, kept);
+  // The order is the limit of the local slope as h -> 0. While a term of the next order still
+  // shows, the local slopes creep towards it geometrically (s(h) = p + c h^k on a geometric
+  // ladder); when the last four do so consistently (their differences keep one sign and shrink by a
+  // steady ratio below 0.9), Aitken's delta-squared takes the limit, and the note says so.
+  std::vector<double> local;
+  for (std::size_t a = 0; a + 1 < kept.size(); ++a) {
+    const std::size_t b = window_end(a);
+    if (h[kept[a]] / h[kept[b]] >= kWindow) local.push_back(slope_between(kept[a], kept[b]));
+  }
+  if (local.size() < 4) return fit;
+  const std::size_t n = local.size();
+  const double d1 = local[n - 3] - local[n - 4], d2 = local[n - 2] - local[n - 3], d3 = local[n - 1] - local[n - 2];
+  const double r1 = d2 / d1, r2 = d3 / d2;
+  if (!(r1 > 0 && r1 <= 0.9 && r2 > 0 && r2 <= 0.9 && std::abs(r2 - r1) <= 0.2)) return fit;
+  const double limit = local[n - 1] + d3 * r2 / (1 - r2);
+  std::ostringstream why;
+  why << "local slopes " << local[n - 4] << ", " << local[n - 3] << ", " << local[n - 2] << ", " << local[n - 1]
+      << " still creeping (differences shrinking by " << r1 << ", " << r2 << "): order " << limit
+      << " by Aitken extrapolation, least-squares slope " << fit.slope;
+  fit.extrapolated = why.str();
+  fit.slope = limit;
   return fit;
 }
 

@@ -318,6 +318,7 @@ void print_table(const Method& m) {
                r.energy_error, r.seconds, static_cast<double>(r.newton_iterations) / r.steps,
                static_cast<double>(r.evaluations) / r.steps);
   for (const auto& why : m.fit.dropped) fmt::print("  not fitted: {}\n", why);
+  if (!m.fit.extrapolated.empty()) fmt::print("  extrapolated: {}\n", m.fit.extrapolated);
 }
 
 }  // namespace

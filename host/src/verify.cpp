@@ -184,6 +184,7 @@ std::string fit_note(const OrderFit& fit, const std::string& what) {
   if (std::getenv("VARIA_VERIFY_TRACE") != nullptr)
     note += fmt::format("; h {}; errors {}", fmt::join(fit.h, " "), fmt::join(fit.errors, " "));
   for (const auto& d : fit.dropped) note += "; dropped " + d;
+  if (!fit.extrapolated.empty()) note += "; " + fit.extrapolated;
   return note;
 }
 

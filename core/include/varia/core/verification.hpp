@@ -29,12 +29,15 @@ struct Predictions {
 // more than 0.3) and a round-off plateau (trailing points whose local slope falls below the one
 // before by more than 0.3), saying why for each; local slopes span a factor 2 in h. The filters apply whenever three points
 // remain to compare; the slope is fitted only on at least kMinimumFitPoints points (fitted()).
+// Where the local slopes still creep geometrically towards their limit, the slope is that limit
+// (Aitken's delta-squared on the last four local slopes), said in `extrapolated`.
 constexpr int kMinimumFitPoints = 4;
 struct OrderFit {
   double slope = 0.0;
   int used = 0;
   std::vector<std::string> dropped;
   std::vector<double> h, errors;  // all the step sizes and errors, fitted or not
+  std::string extrapolated;       // how the slope was extrapolated, when it was
   bool fitted() const { return used >= kMinimumFitPoints; }
 };
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor);
