@@ -235,3 +235,19 @@ TEST_CASE("forced systems: verify measures the order against a reference run of 
     CHECK(*v["ld_order"].measured >= 4 - 0.3);
   }
 }
+
+TEST_CASE("one-step rk4 on kepler is reported drifting in energy; a variational method on the same orbit is not "
+          "(issue #17, defect 7; this one also passed on 5dea526, whose quarter-against-quarter test caught rk4 too)") {
+  const auto kepler = [](const json& method) {
+    json document = scene_of({{"type", "kepler"}}, method, 0.0, 0.05);
+    document["system"]["manifold"]["dim"] = 2;
+    document["initial"] = {{"q", {0.5, 0.0}}, {"v", {0.0, 1.7320508075688772}}};
+    return document;
+  };
+  Verified rk4(kepler({{"construction", "one-step"}, {"one_step", {{"type", "rk4"}}}}));
+  CAPTURE(rk4["energy_bounded"].note);
+  CHECK(rk4["energy_bounded"].holds == false);
+  Verified variational(kepler(galerkin(2, "gauss-lobatto", 3)));
+  CAPTURE(variational["energy_bounded"].note);
+  CHECK(variational["energy_bounded"].holds == true);
+}
