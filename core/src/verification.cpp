@@ -10,52 +10,181 @@
 
 namespace varia {
 
+namespace {
+
+// Least-squares slope of log(value) against log(h) over the points `kept`.
+double log_log_slope(const std::vector<double>& h, const std::vector<double>& value, const std::vector<int>& kept) {
+  double mx = 0, my = 0;
+  for (int k : kept) mx += std::log(h[k]), my += std::log(value[k]);
+  mx /= static_cast<double>(kept.size());
+  my /= static_cast<double>(kept.size());
+  double sxy = 0, sxx = 0;
+  for (int k : kept) {
+    sxy += (std::log(h[k]) - mx) * (std::log(value[k]) - my);
+    sxx += (std::log(h[k]) - mx) * (std::log(h[k]) - mx);
+  }
+  return sxy / sxx;
+}
+
+constexpr double kWindow = 2.0 * (1.0 - 1e-9);
+constexpr double kSpan = 1e6;  // an order ladder wants its largest error this far above its floor  // a factor 2 in h, whatever the rounding of h
+
+std::vector<int> above(const std::vector<double>& value, double floor) {
+  std::vector<int> kept;
+  for (std::size_t k = 0; k < value.size(); ++k)
+    if (value[k] > floor) kept.push_back(static_cast<int>(k));
+  return kept;
+}
+
+}  // namespace
+
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor) {
   OrderFit fit;
+  fit.h = h;
   fit.errors = error;
-  std::vector<int> kept;
+  std::vector<int> kept = above(error, floor);
   for (std::size_t k = 0; k < h.size(); ++k) {
+    if (error[k] > floor) continue;
     std::ostringstream why;
-    if (!(error[k] > floor)) {
-      why << "h = " << h[k] << ": error " << error[k] << " at round-off (below " << floor << ")";
-      fit.dropped.push_back(why.str());
-    } else {
-      kept.push_back(static_cast<int>(k));
-    }
+    why << "h = " << h[k] << ": error " << error[k] << " at round-off (below " << floor << ")";
+    fit.dropped.push_back(why.str());
   }
-  auto local = [&](std::size_t a) {
-    return std::log(error[kept[a]] / error[kept[a + 1]]) / std::log(h[kept[a]] / h[kept[a + 1]]);
+  // The local slope over a window of a factor 2 in h, from kept[a] forwards or from kept[c]
+  // backwards (on a fine ladder neighbouring slopes differ too little to show a trend).
+  auto slope_between = [&](int a, int b) { return std::log(error[a] / error[b]) / std::log(h[a] / h[b]); };
+  auto window_end = [&](std::size_t a) {
+    std::size_t b = a + 1;
+    while (b + 1 < kept.size() && h[kept[a]] / h[kept[b]] < kWindow) ++b;
+    return b;
   };
-  while (kept.size() >= 4 && std::abs(local(0) - local(1)) > 0.3) {
+  auto window_start = [&](std::size_t c) {
+    std::size_t a = c - 1;
+    while (a > 0 && h[kept[a]] / h[kept[c]] < kWindow) --a;
+    return a;
+  };
+  while (kept.size() >= 3) {
+    const std::size_t b = window_end(0);
+    if (b + 1 >= kept.size()) break;
+    const std::size_t c = window_end(b);
+    const double first = slope_between(kept[0], kept[b]), next = slope_between(kept[b], kept[c]);
+    if (std::abs(first - next) <= 0.3) break;
     std::ostringstream why;
-    why << "h = " << h[kept[0]] << ": pre-asymptotic (local slope " << local(0) << ", next "
-        << local(1) << ")";
+    why << "h = " << h[kept[0]] << ": pre-asymptotic (local slope " << first << ", next " << next << ")";
     fit.dropped.push_back(why.str());
     kept.erase(kept.begin());
   }
-  // Trailing points whose local slope breaks away from the one before: a round-off plateau
-  // (the errors stop falling, or fall by chance).
-  while (kept.size() >= 4 &&
-         std::abs(local(kept.size() - 2) - local(kept.size() - 3)) > 0.3) {
+  // Trailing points whose local slope falls below the one before: a round-off plateau (the
+  // errors stop falling).
+  while (kept.size() >= 3) {
+    const std::size_t last = kept.size() - 1, b = window_start(last);
+    if (b == 0) break;
+    const std::size_t a = window_start(b);
+    const double tail = slope_between(kept[b], kept[last]), before = slope_between(kept[a], kept[b]);
+    if (tail >= before - 0.3) break;
     std::ostringstream why;
-    why << "h = " << h[kept.back()] << ": at round-off (local slope " << local(kept.size() - 2)
-        << ", before it " << local(kept.size() - 3) << ")";
+    why << "h = " << h[kept.back()] << ": at round-off (local slope " << tail << ", before it " << before << ")";
     fit.dropped.push_back(why.str());
     kept.pop_back();
   }
   fit.used = static_cast<int>(kept.size());
-  if (kept.size() < 2) return fit;
-  double mx = 0, my = 0;
-  for (int k : kept) mx += std::log(h[k]), my += std::log(error[k]);
-  mx /= kept.size();
-  my /= kept.size();
-  double sxy = 0, sxx = 0;
-  for (int k : kept) {
-    sxy += (std::log(h[k]) - mx) * (std::log(error[k]) - my);
-    sxx += (std::log(h[k]) - mx) * (std::log(h[k]) - mx);
+  if (!fit.fitted()) return fit;
+  fit.slope = log_log_slope(h, error, kept);
+  // The order is the limit of the local slope as h -> 0. While a term of the next order still
+  // shows, the local slopes creep towards it geometrically (s(h) = p + c h^k on a geometric
+  // ladder); when the last four do so consistently (their differences keep one sign and shrink by a
+  // steady ratio below 0.9), Aitken's delta-squared takes the limit, and the note says so.
+  std::vector<double> local;
+  for (std::size_t a = 0; a + 1 < kept.size(); ++a) {
+    const std::size_t b = window_end(a);
+    if (h[kept[a]] / h[kept[b]] >= kWindow) local.push_back(slope_between(kept[a], kept[b]));
   }
-  fit.slope = sxy / sxx;
+  if (local.size() < 4) return fit;
+  const std::size_t n = local.size();
+  const double d1 = local[n - 3] - local[n - 4], d2 = local[n - 2] - local[n - 3], d3 = local[n - 1] - local[n - 2];
+  const double r1 = d2 / d1, r2 = d3 / d2;
+  if (!(r1 > 0 && r1 <= 0.9 && r2 > 0 && r2 <= 0.9 && std::abs(r2 - r1) <= 0.2)) return fit;
+  const double limit = local[n - 1] + d3 * r2 / (1 - r2);
+  std::ostringstream why;
+  why << "local slopes " << local[n - 4] << ", " << local[n - 3] << ", " << local[n - 2] << ", " << local[n - 1]
+      << " still creeping (differences shrinking by " << r1 << ", " << r2 << "): order " << limit
+      << " by Aitken extrapolation, least-squares slope " << fit.slope;
+  fit.extrapolated = why.str();
+  fit.slope = limit;
   return fit;
+}
+
+OrderFit measure_order(const ErrorAt& error_at, double h_top, double h_max, double floor,
+                       const std::vector<double>& given) {
+  std::vector<double> hs, errors;
+  std::vector<std::string> failures;
+  // The error at h, put in order of decreasing h; false on a numerical failure.
+  auto measure = [&](double h) {
+    try {
+      const double error = error_at(h);
+      const auto at = std::find_if(hs.begin(), hs.end(), [&](double other) { return other < h; });
+      errors.insert(errors.begin() + (at - hs.begin()), error);
+      hs.insert(at, h);
+      return true;
+    } catch (const NumericalFailure& e) {
+      std::ostringstream why;
+      why << "h = " << h << ": numerical failure (";
+      if (const auto* step = dynamic_cast<const StepFailure*>(&e))
+        why << "step " << step->step() << " from t = " << step->t() << ", ";
+      why << "residual " << e.residual() << ": " << e.what() << ")";
+      failures.push_back(why.str());
+      return false;
+    }
+  };
+  if (!given.empty()) {
+    for (double h : given) measure(h);
+  } else {
+    int below = 0;
+    for (int k = 0; k < kLadderPoints && below < 2; ++k)
+      if (measure(h_top * std::pow(2.0, -0.25 * k)) && errors.back() <= floor) ++below;
+    // Too few points left by the filters, or the largest error within kSpan of the floor (close to
+    // round-off, which bends the slope): more points above, while the larger steps still run.
+    auto short_of_range = [&] { return !fit_order(hs, errors, floor).fitted() || errors.front() < kSpan * floor; };
+    while (short_of_range() && 2 * h_top <= h_max * (1 + 1e-12) && measure(h_top * std::pow(2.0, 0.25)) &&
+           measure(h_top * std::sqrt(2.0)) && measure(h_top * std::pow(2.0, 0.75)) && measure(2 * h_top))
+      h_top *= 2;
+  }
+  OrderFit fit = fit_order(hs, errors, floor);
+  fit.dropped.insert(fit.dropped.end(), failures.begin(), failures.end());
+  return fit;
+}
+
+DefectScaling defect_scaling(const std::vector<double>& h, const std::vector<double>& values, double noise) {
+  DefectScaling d{h, values, *std::max_element(values.begin(), values.end()), noise, std::nullopt, false, false};
+  // The slope over every point, each taken at least at the noise: a defect that falls into the
+  // noise as h shrinks shrinks; noise alone gives a flat line.
+  if (d.largest > noise && values.size() >= 2) {
+    std::vector<double> floored;
+    std::vector<int> all;
+    for (std::size_t k = 0; k < values.size(); ++k) {
+      floored.push_back(std::max(values[k], noise));
+      all.push_back(static_cast<int>(k));
+    }
+    d.slope = log_log_slope(h, floored, all);
+  }
+  d.shrinks = d.slope && *d.slope >= 1.0;
+  d.zero = !d.shrinks && d.largest <= noise;
+  return d;
+}
+
+std::string DefectScaling::describe() const {
+  std::ostringstream text;
+  text.precision(2);
+  text << std::scientific;
+  for (std::size_t k = 0; k < h.size(); ++k) text << (k ? ", " : "") << values[k] << " at h = " << std::defaultfloat << h[k] << std::scientific;
+  text << std::defaultfloat;
+  if (zero) {
+    text << ": at round-off (within " << std::scientific << noise << std::defaultfloat << ", not shrinking with h)";
+  } else if (slope) {
+    text << ": scaling as h^" << std::round(*slope * 10) / 10;
+  } else {
+    text << ": above round-off (" << std::scientific << noise << std::defaultfloat << ")";
+  }
+  return text.str();
 }
 
 std::vector<SamplePair> sample_pairs(Manifold& manifold, const double* q, const double* v, double h,
@@ -84,6 +213,27 @@ double self_adjointness_residual(DiscreteLagrangian& Ld, const std::vector<Sampl
     Ld.evaluate(pair.q0.data(), pair.q1.data(), h, &forward, nullptr, nullptr);
     Ld.evaluate(pair.q1.data(), pair.q0.data(), -h, &backward, nullptr, nullptr);
     worst = std::max(worst, std::abs(forward + backward) / std::max(std::abs(forward), 1e-300));
+  }
+  return worst;
+}
+
+double round_off_of(DiscreteLagrangian& Ld, Manifold& manifold, const std::vector<SamplePair>& pairs, double h) {
+  const int n = manifold.dim(), m = manifold.point_size();
+  std::vector<double> xi(n), there(m), back0(m), back1(m);
+  auto round_trip = [&](const std::vector<double>& q, std::vector<double>& back) {
+    for (int i = 0; i < n; ++i) xi[i] = 1e-3 * (i + 1);
+    check(manifold, manifold.retract(q.data(), xi.data(), there.data()), "retract");
+    for (double& c : xi) c = -c;
+    check(manifold, manifold.retract(there.data(), xi.data(), back.data()), "retract");
+  };
+  double worst = 0.0;
+  for (const auto& pair : pairs) {
+    round_trip(pair.q0, back0);
+    round_trip(pair.q1, back1);
+    double original = 0.0, moved = 0.0;
+    Ld.evaluate(pair.q0.data(), pair.q1.data(), h, &original, nullptr, nullptr);
+    Ld.evaluate(back0.data(), back1.data(), h, &moved, nullptr, nullptr);
+    worst = std::max(worst, std::abs(moved - original) / std::max(std::abs(original), 1e-300));
   }
   return worst;
 }
@@ -214,13 +364,22 @@ SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& 
   return {fine, std::abs(fine - coarse) + 1e-13};
 }
 
-double drift_ratio(const std::vector<double>& energy_error) {
-  const std::size_t quarter = std::max<std::size_t>(1, energy_error.size() / 4);
-  double first = 0.0, last = 0.0;
-  for (std::size_t k = 0; k < quarter; ++k) first = std::max(first, std::abs(energy_error[k]));
-  for (std::size_t k = energy_error.size() - quarter; k < energy_error.size(); ++k)
-    last = std::max(last, std::abs(energy_error[k]));
-  return last / std::max(first, 1e-300);
+EnergyDrift energy_drift(const std::vector<double>& energy_error) {
+  const double n = static_cast<double>(energy_error.size());
+  double mt = 0, me = 0;
+  for (std::size_t k = 0; k < energy_error.size(); ++k) mt += static_cast<double>(k), me += energy_error[k];
+  mt /= n;
+  me /= n;
+  double ste = 0, stt = 0;
+  for (std::size_t k = 0; k < energy_error.size(); ++k) {
+    ste += (static_cast<double>(k) - mt) * (energy_error[k] - me);
+    stt += (static_cast<double>(k) - mt) * (static_cast<double>(k) - mt);
+  }
+  const double slope = stt > 0 ? ste / stt : 0.0;
+  EnergyDrift drift{std::abs(slope) * (n - 1), 0.0};
+  for (std::size_t k = 0; k < energy_error.size(); ++k)
+    drift.wander = std::max(drift.wander, std::abs(energy_error[k] - me - slope * (static_cast<double>(k) - mt)));
+  return drift;
 }
 
 }  // namespace varia

@@ -105,6 +105,7 @@ struct Options {
   LdOptions ld;
   bool json = false;
   std::string verify_json, cost_out;
+  std::vector<double> verify_h;
   CostOptions cost;
 };
 
@@ -178,11 +179,16 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
                             "each from the declared properties of the parts (the paper's theorems), measure it, "
                             "and print both. Properties: self_adjoint, g_invariant, ld_order, global_order, "
                             "momentum_conserved, symplectic, energy_bounded. Exit 1 when a predicted property "
-                            "does not hold.",
+                            "does not hold or could not be measured.",
                             "Example:\n  varia verify scenes/default.json --json checks.json");
   add_scene(verify, o.scene);
   verify->add_option("--json", o.verify_json, "write the checks as JSON here")->type_name("FILE");
-  verify->callback([&] { chosen = [&] { return command_verify(o.common, o.scene, o.verify_json); }; });
+  verify->add_option("--h", o.verify_h, "the step sizes the orders are fitted at, comma-separated (default: chosen "
+                                        "by verify in the asymptotic range above round-off)")
+      ->delimiter(',')
+      ->allow_extra_args(false)
+      ->type_name("H,H,..");
+  verify->callback([&] { chosen = [&] { return command_verify(o.common, o.scene, o.verify_json, o.verify_h); }; });
 
   auto* cost = subcommand(app, o, "cost",
                           "What accuracy costs in time: error, work and time across step sizes and methods, "

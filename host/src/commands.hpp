@@ -27,6 +27,7 @@ struct LdOptions {
 int command_ld(const CommonOptions& common, const std::string& scene_file, const LdOptions& options);
 // Prints the table of checks (and writes them as JSON when json_file is not empty); 1 when a
 // property the theorems predict was measured not to hold.
-int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file);
+int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,
+                   const std::vector<double>& h);
 
 }  // namespace varia::host

@@ -269,7 +269,7 @@ json method_record(const Method& m) {
   return {{"method", m.name},
           {"scene", m.file},
           {"predicted_order", m.predicted_order},
-          {"fitted_slope", m.fit.used >= 2 ? json(m.fit.slope) : json(nullptr)},
+          {"fitted_slope", m.fit.fitted() ? json(m.fit.slope) : json(nullptr)},
           {"points_fitted", m.fit.used},
           {"points_dropped", m.fit.dropped},
           {"reference", m.truth->source}};
@@ -309,7 +309,7 @@ void write_plot(const std::filesystem::path& file, const std::deque<Method>& met
 
 void print_table(const Method& m) {
   fmt::print(results(), "{} ({}): predicted order {}, fitted slope {}\n  error measured against the {}\n", m.name, m.file,
-             m.predicted_order, m.fit.used >= 2 ? fmt::format("{:.2f} ({} points)", m.fit.slope, m.fit.used) : "-",
+             m.predicted_order, m.fit.fitted() ? fmt::format("{:.2f} ({} points)", m.fit.slope, m.fit.used) : "-",
              m.truth->source);
   fmt::print(results(), "  {:>10} {:>8} {:>11} {:>11} {:>10} {:>11} {:>11}\n", "h", "steps", "error", "energy err", "seconds",
              "Newton/step", "evals/step");
@@ -318,6 +318,7 @@ void print_table(const Method& m) {
                r.energy_error, r.seconds, static_cast<double>(r.newton_iterations) / r.steps,
                static_cast<double>(r.evaluations) / r.steps);
   for (const auto& why : m.fit.dropped) fmt::print(results(), "  not fitted: {}\n", why);
+  if (!m.fit.extrapolated.empty()) fmt::print(results(), "  extrapolated: {}\n", m.fit.extrapolated);
 }
 
 }  // namespace

@@ -24,9 +24,14 @@ struct PropertyCheck {
   std::string note;              // how it was measured, points dropped from a fit
   // A property the theorems predict that was measured not to hold (exit code 1).
   bool failed() const;
+  // A property the theorems predict that could not be measured (`note` says why): verify cannot
+  // exit 0.
+  bool unmeasured() const;
 };
 
-std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& assembly, Registry& registry);
+// `h`: the step sizes the orders are fitted at (varia verify --h); empty: verify chooses them.
+std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& assembly, Registry& registry,
+                                        const std::vector<double>& h = {});
 nlohmann::json checks_json(const std::vector<PropertyCheck>& checks);
 std::string checks_table(const std::vector<PropertyCheck>& checks);
 

@@ -10,6 +10,8 @@
 #include "host/support.hpp"
 #include "errors.hpp"
 #include "scene.hpp"
+#include "assemble.hpp"
+#include "registry.hpp"
 
 namespace varia::host {
 namespace {
@@ -46,6 +48,104 @@ TEST_CASE("an unknown construction is refused with the table's names") {
                        "/method/construction: expected one of \"galerkin\", \"shooting\", \"one-step\", "
                        "\"lie-verlet\"; found \"galerkn\"",
                        InputError);
+}
+
+}  // namespace
+}  // namespace varia::host
+
+namespace varia::host {
+namespace {
+
+// The predictions of a scene's composed integrator, from its construction (verify's first step).
+struct Predicted {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  Assembly assembly;
+  Predictions predictions;
+  explicit Predicted(const json& document) {
+    scene = parse_scene(document);
+    validate_parameters(scene, registry);
+    assembly = assemble(scene, registry);
+    predictions = scene.construction->predict(scene, assembly);
+  }
+};
+
+json pendulum_with(const json& method) {
+  return {{"system", {{"manifold", {{"type", "Rn"}, {"dim", 1}}}, {"lagrangian", {{"type", "pendulum"}}}}},
+          {"method", method},
+          {"initial", {{"q", {1.0}}, {"p", {0.0}}}},
+          {"step", 0.1},
+          {"steps", 10}};
+}
+
+json rigid_body_with(const json& method) {
+  return {{"system",
+           {{"manifold", {{"type", "SO3"}}},
+            {"lagrangian", {{"type", "heavy-top"}, {"inertia", {1, 1.5, 0.8}}, {"mass", 1}, {"gravity", 1},
+                            {"center_of_mass", {0.1, 0.2, 0.5}}}}}},
+          {"method", method},
+          {"initial", {{"q", {1, 0, 0, 0, 1, 0, 0, 0, 1}}, {"v", {0.5, -0.3, 2.0}}}},
+          {"step", 0.01},
+          {"steps", 10}};
+}
+
+json galerkin_with(int degree, const char* rule, int points) {
+  json quadrature{{"type", rule}};
+  if (points > 0) quadrature["points"] = points;
+  return {{"construction", "galerkin"}, {"degree", degree}, {"quadrature", quadrature}};
+}
+
+TEST_CASE("predictions follow the theorems' hypotheses (issue #17, defects 1, 2, 4, 5; each failed on 5dea526)") {
+  const json null;
+  struct Row {
+    const char* what;
+    json scene;
+    json ld_order, self_adjoint, symplectic, momentum_conserved;
+  };
+  const json shooting_type2{{"construction", "shooting"}, {"form", "type-2"}, {"one_step", {{"type", "rk4"}}},
+                            {"quadrature", {{"type", "simpson"}}}};
+  const std::vector<Row> rows{
+      // Defect 1: r < s Gauss points determine fewer interior points: order 2 (r - 1), not min(2s, 2r).
+      {"galerkin s = 3, 2 Gauss points", pendulum_with(galerkin_with(3, "gauss-legendre", 2)), 2, true, true, null},
+      {"galerkin s = 4, 3 Gauss points", pendulum_with(galerkin_with(4, "gauss-legendre", 3)), 4, true, true, null},
+      // Defect 2: the self-adjointness proposition is for the Type I form.
+      {"type-2 shooting, rk4 + simpson", pendulum_with(shooting_type2), "any", null, "any", null},
+      // Defect 4: Runge-Kutta in the embedding of SO(3) is not canonical.
+      {"one-step implicit midpoint on SO(3)",
+       rigid_body_with({{"construction", "one-step"}, {"one_step", {{"type", "implicit-midpoint"}}}}), "any", "any",
+       false, "any"},
+      // Defect 5: shooting with a propagator that leaves SO(3) promises neither.
+      {"shooting rk4 on SO(3)",
+       rigid_body_with({{"construction", "shooting"}, {"one_step", {{"type", "rk4"}}},
+                        {"quadrature", {{"type", "gauss-lobatto"}, {"points", 3}}}}),
+       "any", "any", null, null},
+  };
+  const auto as_json = [](const auto& optional) { return optional ? json(*optional) : json(nullptr); };
+  for (const Row& row : rows) {
+    CAPTURE(std::string(row.what));
+    const Predicted p(row.scene);
+    CAPTURE(p.predictions.reason);
+    if (row.ld_order != "any") CHECK(as_json(p.predictions.ld_order) == row.ld_order);
+    if (row.self_adjoint != "any") CHECK(as_json(p.predictions.self_adjoint) == row.self_adjoint);
+    if (row.symplectic != "any") CHECK(as_json(p.predictions.symplectic) == row.symplectic);
+    if (row.momentum_conserved != "any") CHECK(as_json(p.predictions.momentum_conserved) == row.momentum_conserved);
+  }
+}
+
+TEST_CASE("a galerkin rule too weak to determine the interior control points is refused at /method/quadrature "
+          "(defect 1; on 5dea526 it passed validate and verify exited 4)") {
+  for (const json& method : {galerkin_with(2, "midpoint", 0), galerkin_with(3, "trapezoid", 0),
+                             galerkin_with(4, "simpson", 0)}) {
+    CAPTURE(method.dump());
+    std::string message;
+    try {
+      Predicted p(pendulum_with(method));
+    } catch (const InputError& e) {
+      message = e.what();
+    }
+    CHECK(message.rfind("/method/quadrature", 0) == 0);
+    CHECK(message.find("too weak") != std::string::npos);
+  }
 }
 
 }  // namespace

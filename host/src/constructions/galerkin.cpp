@@ -24,11 +24,37 @@ struct GalerkinOptions : MethodOptions {
   bool reduced = false;
 };
 
-// Control times symmetric about 1/2: d_nu + d_{s-nu} = 1 (paper, sec. 3: self-adjointness).
-bool symmetric(const std::vector<double>& d) {
-  for (std::size_t nu = 0; nu < d.size(); ++nu)
-    if (std::abs(d[nu] + d[d.size() - 1 - nu] - 1.0) > 1e-14) return false;
-  return true;
+// What a quadrature rule determines of the degree-s interpolant. Its velocity, a polynomial of
+// degree s - 1, is seen at the r nodes with a weight; s nodes determine it, and the order is
+// min(2s, the rule's order) (paper, sec. 2). With r < s, the s - r velocities that vanish at every
+// node are invisible to the kinetic energy and fixed only through the positions at the nodes
+// inside (0, 1) (the endpoint nodes see q0 and q1, which the equations do not move): the interior
+// nodes spend one order-2 pair per such direction, and the order is 2 (r_interior - (s - r)); at
+// most 0 the discrete Lagrangian does not converge (s = 2 with the midpoint rule, s = 4 with
+// Simpson's) or its equations are singular (s = 3 with the trapezoid rule), and the composition is
+// refused. Measured against exact solutions (tests/host/theorems.cpp): Gauss-Legendre r = s - 1
+// gives 2(r - 1), r = s - 2 gives 2(r - 2); Gauss-Lobatto with r = s - 1 gives 2(r - 3).
+struct Determination {
+  int order = 0;
+  std::string how;
+};
+
+Determination determination(const Quadrature& rule, int s) {
+  int r = 0, interior = 0;
+  for (int i = 0; i < rule.size(); ++i) {
+    if (rule.weights()[i] == 0.0) continue;
+    ++r;
+    if (rule.nodes()[i] > 0.0 && rule.nodes()[i] < 1.0) ++interior;
+  }
+  const int q = quadrature_order(rule);
+  if (r >= s)
+    return {std::min(2 * s, q), fmt::format("order min(2s, quadrature order) = min({}, {}): {} nodes determine the "
+                                            "degree-{} velocity",
+                                            2 * s, q, r, s - 1)};
+  return {2 * (interior - (s - r)),
+          fmt::format("under-integrated: {} nodes see {} of the {} velocity coefficients; the other {} are fixed only "
+                      "through the positions at the {} interior nodes: order 2 ({} - {}) = {}",
+                      r, r, s, s - r, interior, interior, s - r, 2 * (interior - (s - r)))};
 }
 
 class Galerkin final : public Construction {
@@ -72,6 +98,11 @@ class Galerkin final : public Construction {
   void build(const Scene& scene, Registry& registry, Assembly& a) const override {
     const auto& o = options(scene);
     a.quadrature = make_part<Quadrature>(registry, *scene.quadrature, scene, *a.manifold);
+    const Determination d = determination(*a.quadrature, o.degree);
+    if (d.order <= 0)
+      throw InputError(fmt::format("{}: the rule is too weak for degree {}: {}, so the discrete Lagrangian does not "
+                                   "converge or its equations are singular; use at least {} nodes inside (0, 1)",
+                                   scene.quadrature->pointer, o.degree, d.how, o.degree));
     if (!a.manifold->is_vector_space()) return build_on_group(scene, o, a);
     if (o.reduced)
       throw InputError("/method/reduced: the reduced (Euler-Poincare) form is for Lie groups; " + scene.manifold.type +
@@ -82,18 +113,20 @@ class Galerkin final : public Construction {
     a.map = std::move(map);
   }
 
-  // Order min(2s, quadrature order); self-adjoint for a symmetric rule and symmetric control
-  // times on a vector space (the chart at q0 of a Lie group is not symmetric in q0 and q1: no
-  // prediction there); G-invariant L_d from the equivariant interpolant.
+  // The order from what the rule determines (determination()); self-adjoint for a symmetric rule on
+  // a vector space, whatever the control times: L_d extremizes over the polynomials of degree s,
+  // which the control times only parametrize (the chart at q0 of a Lie group is not symmetric in q0
+  // and q1: no prediction there); G-invariant L_d from the equivariant interpolant.
   Predictions predict(const Scene& scene, const Assembly& a) const override {
-    const auto& o = options(scene);
+    const Determination d = determination(*a.quadrature, options(scene).degree);
     Predictions p;
-    p.ld_order = p.global_order = std::min(2 * o.degree, quadrature_order(*a.quadrature));
-    if (a.manifold->is_vector_space()) p.self_adjoint = a.quadrature->symmetric() && symmetric(o.control_times);
+    p.ld_order = p.global_order = d.order;
+    if (a.manifold->is_vector_space()) p.self_adjoint = a.quadrature->symmetric();
     p.symplectic = p.energy_bounded = true;
-    p.reason = "Galerkin (sec. 2): order min(2s, quadrature order); self-adjoint for a symmetric rule and control "
-               "times (on a vector space: the natural chart at q0 of a Lie group is not symmetric); G-invariant L_d "
-               "from an equivariant interpolant";
+    p.reason = "Galerkin (sec. 2): " + d.how +
+               "; self-adjoint for a symmetric rule on a vector space (L_d depends on the polynomial space, not on "
+               "the control times; the natural chart at q0 of a Lie group is not symmetric); G-invariant L_d from an "
+               "equivariant interpolant";
     apply_shared_theorems(a, true, p);
     return p;
   }

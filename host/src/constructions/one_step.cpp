@@ -30,15 +30,21 @@ class OneStep final : public Construction {
 
   // What the method declares: its order, self-adjointness and symplecticity; a symplectic method
   // that commutes with the symmetry conserves its momentum map (no L_d, no G-invariance claim).
+  // A Runge-Kutta method's symplecticity is for canonical coordinates: on a Lie group it integrates
+  // (q, velocity) in the embedding, which are not, so it is predicted not symplectic there.
   Predictions predict(const Scene&, const Assembly& a) const override {
     const DeclaredMethod method = declared(a);
+    const bool symplectic = method.symplectic && method.stays_on_group;
     Predictions p;
     p.global_order = method.order;
     p.self_adjoint = method.self_adjoint;
-    p.symplectic = method.symplectic;
-    if (method.symplectic) p.energy_bounded = true;
-    if (declares_symmetry(*a.lagrangian) && method.symplectic && method.equivariant) p.momentum_conserved = true;
+    p.symplectic = symplectic;
+    if (symplectic) p.energy_bounded = true;
+    if (declares_symmetry(*a.lagrangian) && symplectic && method.equivariant) p.momentum_conserved = true;
     p.reason = "one-step method: its declared order, self-adjointness and symplecticity (no L_d)";
+    if (method.symplectic && !symplectic)
+      p.reason += "; its symplecticity is for canonical coordinates, and on a Lie group it integrates in the "
+                  "embedding: predicted not symplectic";
     apply_shared_theorems(a, std::nullopt, p);
     return p;
   }

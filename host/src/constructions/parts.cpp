@@ -24,7 +24,8 @@ void make_one_step(const Scene& scene, Registry& registry, Assembly& a) {
 DeclaredMethod declared(const Assembly& a) {
   const std::string equivariance = a.one_step->equivariance();
   return DeclaredMethod{a.one_step->order(), a.one_step->self_adjoint(), a.one_step_symplectic,
-                        equivariance == "affine" || equivariance == "left"};
+                        equivariance == "affine" || equivariance == "left",
+                        a.manifold->is_vector_space() || equivariance == "left"};
 }
 
 nlohmann::json plugin_schema(const char* description) {

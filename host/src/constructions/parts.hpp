@@ -57,6 +57,10 @@ struct DeclaredMethod {
   // embedding it integrates in; "left" (Lie group methods) with left multiplication on the group,
   // and with affine maps where the group is R^n.
   bool equivariant = false;
+  // Its propagation stays on the manifold: every method on a vector space; on a Lie group only a
+  // Lie group method ("left"), not a Runge-Kutta method integrating in the embedding, whose stages
+  // leave the group (and whose coordinates there are not canonical).
+  bool stays_on_group = true;
 };
 void make_one_step(const Scene& scene, Registry& registry, Assembly& a);
 DeclaredMethod declared(const Assembly& a);

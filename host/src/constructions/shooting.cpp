@@ -55,16 +55,27 @@ class Shooting final : public Construction {
   }
 
   // The paper's theorem (sec. 3): order min(p, quadrature order); self-adjoint for a self-adjoint
-  // method and a symmetric rule; G-invariant for a G-equivariant method.
+  // method and a symmetric rule (the proposition is for the Type I form: nothing for type-2);
+  // G-invariant for a G-equivariant method; symplectic and, with an invariant L_d,
+  // momentum-conserving as a variational integrator on Q x Q, which needs a propagation that stays
+  // on Q (on a Lie group: a Lie group method).
   Predictions predict(const Scene& scene, const Assembly& a) const override {
     const DeclaredMethod method = declared(a);
+    const bool type_2 = options(scene).form == "type-2";
     Predictions p;
     p.ld_order = p.global_order = std::min(method.order, quadrature_order(*a.quadrature));
-    p.self_adjoint = method.self_adjoint && a.quadrature->symmetric();
+    if (!type_2) p.self_adjoint = method.self_adjoint && a.quadrature->symmetric();
     p.symplectic = p.energy_bounded = true;
     p.reason = "shooting (sec. 3 theorem): order min(p, q); self-adjoint for a self-adjoint method and a symmetric "
-               "rule; G-invariant for a G-equivariant method";
+               "rule (Type I form; no prediction for type-2); G-invariant for a G-equivariant method";
     apply_shared_theorems(a, method.equivariant, p);
+    if (!method.stays_on_group) {
+      p.symplectic.reset();
+      p.energy_bounded.reset();
+      p.momentum_conserved.reset();
+      p.reason += "; the method's propagation leaves the group: L_d is not a function on G x G, no conservation "
+                  "theorem applies";
+    }
     return p;
   }
 

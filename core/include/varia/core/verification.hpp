@@ -4,6 +4,7 @@
 // properties of the parts. The host builds the objects and prints the report.
 #pragma once
 
+#include <algorithm>
 #include <functional>
 #include <optional>
 #include <string>
@@ -25,15 +26,48 @@ struct Predictions {
 
 // A least-squares slope of log(error) against log(h) that drops points at round-off (error below
 // `floor`), pre-asymptotic points (leading points whose local slope differs from the next by
-// more than 0.3) and a round-off plateau (trailing points whose local slope breaks away from the
-// one before by more than 0.3), saying why for each.
+// more than 0.3) and a round-off plateau (trailing points whose local slope falls below the one
+// before by more than 0.3), saying why for each; local slopes span a factor 2 in h. The filters apply whenever three points
+// remain to compare; the slope is fitted only on at least kMinimumFitPoints points (fitted()).
+// Where the local slopes still creep geometrically towards their limit, the slope is that limit
+// (Aitken's delta-squared on the last four local slopes), said in `extrapolated`.
+constexpr int kMinimumFitPoints = 4;
 struct OrderFit {
   double slope = 0.0;
   int used = 0;
   std::vector<std::string> dropped;
-  std::vector<double> errors;  // all the errors, fitted or not
+  std::vector<double> h, errors;  // all the step sizes and errors, fitted or not
+  std::string extrapolated;       // how the slope was extrapolated, when it was
+  bool fitted() const { return used >= kMinimumFitPoints; }
 };
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor);
+
+// An order measured at step sizes it chooses in the asymptotic range above round-off: a ladder
+// h_top 2^(-k/4) down to two points below `floor` (at most kLadderPoints), whose top is doubled
+// (at most up to h_max) while the filters leave fewer than kMinimumFitPoints points or the largest
+// error is within six decades of the floor; or at
+// the `given` step sizes alone (varia verify --h). error_at(h) may adjust h (e.g. to whole steps to
+// a final time); a NumericalFailure at a step size drops that point, saying so.
+constexpr int kLadderPoints = 24;
+using ErrorAt = std::function<double(double& h)>;
+OrderFit measure_order(const ErrorAt& error_at, double h_top, double h_max, double floor,
+                       const std::vector<double>& given);
+
+// A defect that should vanish (a self-adjointness, invariance or symplecticity residual, a drift
+// of a conserved quantity), measured at decreasing step sizes. It counts as zero when it stays
+// within `noise`, the round-off the measurement itself shows (or kNoiseSpread times the quantity's
+// own round-off unit), where it cannot shrink with h; otherwise it is reported with its scaling: the
+// log-log slope over every point, each taken at least at the noise (a slope of 1 or more: it
+// shrinks with h, a term of the method).
+constexpr double kNoiseSpread = 1e4;
+struct DefectScaling {
+  std::vector<double> h, values;
+  double largest = 0.0, noise = 0.0;
+  std::optional<double> slope;  // when the largest value is above the noise
+  bool shrinks = false, zero = false;
+  std::string describe() const;  // "4.1e-09 at h = 0.1, scaling as h^4.9" or "at round-off"
+};
+DefectScaling defect_scaling(const std::vector<double>& h, const std::vector<double>& values, double noise);
 
 // Sample pairs (q0, q1) near the diagonal: q0 = retract(q, small), q1 = retract(q0, h v + small).
 struct SamplePair {
@@ -45,6 +79,10 @@ std::vector<SamplePair> sample_pairs(Manifold& manifold, const double* q, const 
 // max |L_d(q0, q1; h) + L_d(q1, q0; -h)| / scale: zero when L_d is self-adjoint (paper, sec. 3).
 double self_adjointness_residual(DiscreteLagrangian& Ld, const std::vector<SamplePair>& pairs,
                                  double h);
+// The round-off of L_d at the pairs, measured: max |L_d(q0', q1') - L_d(q0, q1)| / |L_d| where q'
+// is q moved away and back (q exp(xi) exp(-xi)), equal to q but for round-off. The floor of the
+// two residuals below.
+double round_off_of(DiscreteLagrangian& Ld, Manifold& manifold, const std::vector<SamplePair>& pairs, double h);
 // max |L_d(g q0, g q1) - L_d(q0, q1)| / scale over pseudo-random g of the declared group.
 double invariance_residual(DiscreteLagrangian& Ld, Lagrangian& lagrangian,
                            const std::vector<SamplePair>& pairs, double h);
@@ -72,9 +110,16 @@ struct SymplecticityDefect {
 SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& manifold,
                                          const double* q0, const double* p0, double h);
 
-// Whether the energy error drifts: the largest error over the last quarter of the run against
-// the largest over the first quarter (a bounded error gives a ratio near 1, a drift about 3 or
-// more for a linear growth).
-double drift_ratio(const std::vector<double>& energy_error);
+// The energy error's drift over a run: a least-squares line through E - E0 against time; `trend`
+// is its change over the run, `wander` the largest distance of the error from the line. A drift
+// (non-symplectic methods: E - E0 grows like t h^p) is mostly trend; the bounded error of a
+// symplectic method (a function of the state, h^p e(x)) is mostly wander, also when the motion
+// is chaotic and the error wanders as the state explores the energy surface.
+struct EnergyDrift {
+  double trend = 0.0, wander = 0.0;
+  // trend / (trend + wander): near 1 for a drift, small for a bounded error.
+  double share() const { return trend / std::max(trend + wander, 1e-300); }
+};
+EnergyDrift energy_drift(const std::vector<double>& energy_error);
 
 }  // namespace varia
