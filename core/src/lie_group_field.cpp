@@ -62,9 +62,10 @@ void LieGroupField::prepare(const double* y) {
 }
 
 void LieGroupField::prepare(const Jet2* y) {
-  if (structure_.empty()) {
-    for (int k = 0; k < m_; ++k) generators_[k] = y[k].value;  // the point's values, briefly
-    learn_structure(generators_.data());
+  if (structure_.empty()) {  // once, on the first evaluation
+    std::vector<double> point(m_);
+    for (int k = 0; k < m_; ++k) point[k] = y[k].value;
+    learn_structure(point.data());
   }
   check(manifold_, manifold_.generators(y, generators_jet_.data()), "manifold generators");
   lagrangian_.gradient_jet(y, y + m_, nullptr, gradient_jet_.data());
