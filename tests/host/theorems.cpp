@@ -11,6 +11,8 @@
 #include "registry.hpp"
 #include "scene.hpp"
 #include "support.hpp"
+#include "varia/core/mechanics.hpp"
+#include "varia/core/verification.hpp"
 #include "verify.hpp"
 
 using namespace varia;
@@ -47,6 +49,27 @@ struct Verified {
     return *std::find_if(checks.begin(), checks.end(), [&](const auto& c) { return c.name == name; });
   }
 };
+
+json bundled_scene(const std::string& path) {
+  return json::parse(varia::test::read_file(varia::test::kSourceDir / "scenes" / path));
+}
+
+// The energy test verify used before issue #17: max |E - E0| over the last quarter of `steps` steps
+// of the scene's integrator over that of the first quarter, a drift when above 2.
+double quarter_ratio(Verified& v, long steps) {
+  LagrangianEvaluator lagrangian(*v.assembly.lagrangian);
+  std::vector<double> velocity(v.assembly.p0.size(), 0.0), error;
+  double E0 = 0.0;
+  run(*v.assembly.map, v.assembly.q0, v.assembly.p0, v.assembly.t0, v.scene.step, steps,
+      [&](long k, const double* q, const double* p) {
+        lagrangian.inverse_legendre(q, p, velocity.data(), v.scene.solver);
+        const double E = lagrangian.energy(q, velocity.data());
+        if (k == 0) E0 = E;
+        error.push_back(std::abs(E - E0));
+      });
+  const auto quarter = static_cast<std::ptrdiff_t>(error.size() / 4);
+  return *std::max_element(error.end() - quarter, error.end()) / *std::max_element(error.begin() + 1, error.begin() + quarter);
+}
 
 }  // namespace
 
@@ -250,4 +273,28 @@ TEST_CASE("one-step rk4 on kepler is reported drifting in energy; a variational 
   Verified variational(kepler(galerkin(2, "gauss-lobatto", 3)));
   CAPTURE(variational["energy_bounded"].note);
   CHECK(variational["energy_bounded"].holds == true);
+}
+
+TEST_CASE("energy_bounded tells wandering from drift on chaotic and resting starts: a chaotic double pendulum and "
+          "the spring chain released from rest are bounded (issue #17, defect 7: the quarter-against-quarter test called "
+          "both drifting)") {
+  json pendulum = bundled_scene("hard/double-pendulum.json");
+  pendulum["initial"]["q"] = {1.0, 2.0};  // chaotic, and its energy error happens to grow over the first 10^4 steps
+  pendulum["steps"] = 10000;
+  for (const json& scene : {pendulum, bundled_scene("effects/spring-chain-gravity.json")}) {
+    CAPTURE(scene["description"].get<std::string>());
+    Verified v(scene);
+    CHECK(quarter_ratio(v, 10000) > 2.0);  // the old rule's alarm on this very scene
+    CAPTURE(v["energy_bounded"].note);
+    CHECK(v["energy_bounded"].holds == true);
+  }
+}
+
+TEST_CASE("ld_order on the planets (scenes/effects/planetary.json) is 4: the L_d error is the largest over three "
+          "base states, so that one state's sign change near h = 0.028 no longer bends the fit (was 3.47, exit 1)") {
+  Verified v(bundled_scene("effects/planetary.json"));
+  CAPTURE(v["ld_order"].note);
+  REQUIRE(v["ld_order"].measured);
+  CHECK(*v["ld_order"].measured == doctest::Approx(4.0).epsilon(0.3 / 4));
+  for (const auto& c : v.checks) CHECK_FALSE((c.failed() || c.unmeasured()));
 }
