@@ -98,6 +98,8 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
     const std::size_t b = window_end(a);
     if (h[kept[a]] / h[kept[b]] >= kWindow) local.push_back(slope_between(kept[a], kept[b]));
   }
+  const std::size_t m = local.size();
+  fit.still_rising = m >= 2 && local[m - 1] > local[m - 2] && (m == 2 || local[m - 2] > local[m - 3]);
   if (local.size() < 4) return fit;
   const std::size_t n = local.size();
   const double d1 = local[n - 3] - local[n - 4], d2 = local[n - 2] - local[n - 3], d3 = local[n - 1] - local[n - 2];
@@ -110,6 +112,7 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
       << " by Aitken extrapolation, least-squares slope " << fit.slope;
   fit.extrapolated = why.str();
   fit.slope = limit;
+  fit.still_rising = false;
   return fit;
 }
 

@@ -201,14 +201,21 @@ PropertyCheck order_check(const char* name, const std::optional<int>& predicted,
   }
   c.measured = fit.slope;
   c.holds = predicted ? *c.measured >= *predicted - kOrderSlack : true;
+  if (!*c.holds && fit.still_rising) {
+    c.holds.reset();
+    c.note += fmt::format("; not measured: the local slopes still rise at the smallest step above round-off, so {:.3g} "
+                          "is a lower bound and the asymptotic range was not reached (set the step sizes with --h)",
+                          fit.slope);
+  }
   return c;
 }
 
 // L_d^E and q1 from the exact solution, or from a reference Galerkin construction of order 12,
 // at kBases base states away from special ones: a release from rest is time-symmetric and can
-// cancel error terms that a generic state shows, and at one base state the leading error term can
-// change sign near some h, a dip that bends the fitted slope. The error at h is the largest over
-// the bases, whose dips fall at different h.
+// cancel error terms that a generic state shows, and at one base state the error's leading terms
+// can cancel near some h (a sign change), bending the local slopes far below and above the order
+// over the decades that follow. The order is fitted at each base state; the measurement is the
+// median of the fitted orders, so that one base state's cancellation does not decide it.
 constexpr int kBases = 3;
 
 struct ExactLd {
@@ -245,7 +252,7 @@ ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& refere
                                 base.v.data(), h, q1.data(), &LdE);
     };
     exact.name = fmt::format("the exact discrete Lagrangian at {} states of the exact motion (t = 0.37, 0.98, 1.59; "
-                             "16-point Gauss-Legendre), the largest error", kBases);
+                             "16-point Gauss-Legendre)", kBases);
     return exact;
   }
   reference = reference_galerkin(x, 6, 8);
@@ -258,7 +265,7 @@ ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& refere
     reference.discrete_lagrangian->evaluate(base.q0.data(), q1.data(), h, &LdE, nullptr, nullptr);
   };
   exact.name = fmt::format("a reference Galerkin L_d of order 12 (degree 6, 8 Gauss-Legendre points) at {} initial "
-                           "velocities, the largest error",
+                           "velocities",
                            kBases);
   return exact;
 }
@@ -278,23 +285,31 @@ PropertyCheck ld_order(Context& x) {
   Assembly reference;
   const ExactLd exact = exact_ld(x, fine, reference);
   std::vector<double> q1(x.m);
-  std::vector<double> scale(exact.bases.size(), 0.0);  // |L| along each curve, fixed at the first (largest) h
-  const OrderFit fit = ladder(
-      x,
-      [&](double& h) {
-        double error = 0.0;
-        for (std::size_t b = 0; b < exact.bases.size(); ++b) {
+  std::vector<OrderFit> fits;
+  for (const ExactLd::Base& base : exact.bases) {
+    double scale = 0.0;  // |L| along the curve, fixed at the first (largest) step size
+    fits.push_back(ladder(
+        x,
+        [&](double& h) {
           double LdE = 0.0, Ld = 0.0;
-          exact.at(exact.bases[b], h, q1, LdE);
-          x.a.discrete_lagrangian->evaluate(exact.bases[b].q0.data(), q1.data(), h, &Ld, nullptr, nullptr);
-          if (scale[b] == 0.0) scale[b] = std::max(std::abs(LdE) / h, kEpsilon);
-          error = std::max(error, std::abs(Ld - LdE) / (h * scale[b]));
-        }
-        return error;
-      },
-      2.0 * x.scene.step, 1e3 * kEpsilon);
-  return order_check("ld_order", x.predictions.ld_order, fit,
-                     x.predictions.reason + ". Measured: slope of |L_d - L_d^E| / (h |L|) against h; L_d^E from " + exact.name);
+          exact.at(base, h, q1, LdE);
+          x.a.discrete_lagrangian->evaluate(base.q0.data(), q1.data(), h, &Ld, nullptr, nullptr);
+          if (scale == 0.0) scale = std::max(std::abs(LdE) / h, kEpsilon);
+          return std::abs(Ld - LdE) / (h * scale);
+        },
+        2.0 * x.scene.step, 1e3 * kEpsilon));
+  }
+  std::vector<const OrderFit*> fitted;
+  std::string slopes;
+  for (const OrderFit& fit : fits) {
+    slopes += (slopes.empty() ? "" : ", ") + (fit.fitted() ? fmt::format("{:.3g}", fit.slope) : std::string("-"));
+    if (fit.fitted()) fitted.push_back(&fit);
+  }
+  std::sort(fitted.begin(), fitted.end(), [](const OrderFit* a, const OrderFit* b) { return a->slope < b->slope; });
+  const OrderFit& median = fitted.empty() ? fits.front() : *fitted[(fitted.size() - 1) / 2];
+  return order_check("ld_order", x.predictions.ld_order, median,
+                     x.predictions.reason + ". Measured: slope of |L_d - L_d^E| / (h |L|) against h; L_d^E from " +
+                         exact.name + "; fitted orders " + slopes + ", the median's fit");
 }
 
 double state_distance(Context& x, const double* q, const double* p, const double* qe, const double* pe) {

@@ -38,6 +38,9 @@ struct OrderFit {
   std::vector<std::string> dropped;
   std::vector<double> h, errors;  // all the step sizes and errors, fitted or not
   std::string extrapolated;       // how the slope was extrapolated, when it was
+  // The last local slopes (three, or two when there are only two) still rise and were not extrapolated: the fit may end before its
+  // asymptotic range, and its slope is then a lower bound of the order.
+  bool still_rising = false;
   bool fitted() const { return used >= kMinimumFitPoints; }
 };
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor);
