@@ -117,13 +117,22 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
 }
 
 OrderFit measure_order(const ErrorAt& error_at, double h_top, double h_max, double floor,
-                       const std::vector<double>& given) {
+                       const std::vector<double>& given, const NoiseAt& noise_at) {
   std::vector<double> hs, errors;
   std::vector<std::string> failures;
-  // The error at h, put in order of decreasing h; false on a numerical failure.
+  // The error at h, put in order of decreasing h (at 0, below any floor, when it is within its
+  // measured round-off); false on a numerical failure.
   auto measure = [&](double h) {
     try {
-      const double error = error_at(h);
+      double error = error_at(h);
+      if (noise_at && error > floor) {
+        if (const double noise = noise_at(h); error <= noise) {
+          std::ostringstream why;
+          why << "h = " << h << ": error " << error << " within its measured round-off " << noise;
+          failures.push_back(why.str());
+          error = 0.0;
+        }
+      }
       const auto at = std::find_if(hs.begin(), hs.end(), [&](double other) { return other < h; });
       errors.insert(errors.begin() + (at - hs.begin()), error);
       hs.insert(at, h);
@@ -229,14 +238,23 @@ double round_off_of(DiscreteLagrangian& Ld, Manifold& manifold, const std::vecto
     for (double& c : xi) c = -c;
     check(manifold, manifold.retract(there.data(), xi.data(), back.data()), "retract");
   };
+  // q moved by one unit in the last place of every coordinate, away from zero: the rounding of an
+  // endpoint, which L_d near the diagonal magnifies by |q| / |q1 - q0|.
+  auto ulp = [](const std::vector<double>& q, std::vector<double>& moved) {
+    for (std::size_t i = 0; i < q.size(); ++i) moved[i] = std::nextafter(q[i], q[i] < 0 ? -INFINITY : INFINITY);
+  };
   double worst = 0.0;
   for (const auto& pair : pairs) {
-    round_trip(pair.q0, back0);
-    round_trip(pair.q1, back1);
     double original = 0.0, moved = 0.0;
     Ld.evaluate(pair.q0.data(), pair.q1.data(), h, &original, nullptr, nullptr);
+    const double scale = std::max(std::abs(original), 1e-300);
+    round_trip(pair.q0, back0);
+    round_trip(pair.q1, back1);
     Ld.evaluate(back0.data(), back1.data(), h, &moved, nullptr, nullptr);
-    worst = std::max(worst, std::abs(moved - original) / std::max(std::abs(original), 1e-300));
+    worst = std::max(worst, std::abs(moved - original) / scale);
+    ulp(pair.q1, back1);
+    Ld.evaluate(pair.q0.data(), back1.data(), h, &moved, nullptr, nullptr);
+    worst = std::max(worst, std::abs(moved - original) / scale);
   }
   return worst;
 }

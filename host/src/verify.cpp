@@ -272,8 +272,8 @@ ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& refere
 
 // The order ladder's start and ceiling: the scene's step (twice it for L_d, whose error is local)
 // and kRaise times that.
-OrderFit ladder(Context& x, const ErrorAt& error_at, double top, double floor) {
-  return measure_order(error_at, top, kRaise * top, floor, x.given_h);
+OrderFit ladder(Context& x, const ErrorAt& error_at, double top, double floor, const NoiseAt& noise_at = {}) {
+  return measure_order(error_at, top, kRaise * top, floor, x.given_h, noise_at);
 }
 
 // The slope of |L_d - L_d^E| / (h |L|) against h: the order of L_d (paper, sec. 1: variational
@@ -297,7 +297,13 @@ PropertyCheck ld_order(Context& x) {
           if (scale == 0.0) scale = std::max(std::abs(LdE) / h, kEpsilon);
           return std::abs(Ld - LdE) / (h * scale);
         },
-        2.0 * x.scene.step, 1e3 * kEpsilon));
+        2.0 * x.scene.step, 1e3 * kEpsilon,
+        // L_d's own round-off near this base state at h (it grows as h shrinks), ten times: a whole
+        // unit in the last place of every coordinate is already the largest rounding.
+        [&](double h) {
+          const auto pairs = sample_pairs(*x.a.manifold, base.q0.data(), base.v.data(), h, kPairs);
+          return 10 * round_off_of(*x.a.discrete_lagrangian, *x.a.manifold, pairs, h);
+        }));
   }
   std::vector<const OrderFit*> fitted;
   std::string slopes;

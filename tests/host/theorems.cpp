@@ -328,7 +328,7 @@ TEST_CASE("orders are fitted on at least four points in the asymptotic range, an
   }
   REQUIRE(v["global_order"].measured);
   CHECK(*v["global_order"].measured >= 6 - 0.3);
-  for (const char* path : {"hard/kepler-e0.9.json", "hard/kepler-e0.9-shooting.json"}) {
+  for (const char* path : {"hard/kepler-e0.9.json", "hard/kepler-e0.9-shooting.json", "hard/kepler-e0.99.json"}) {
     CAPTURE(path);
     const Verified hard(bundled_scene(path));
     for (const char* name : {"ld_order", "global_order"}) {

@@ -50,11 +50,14 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
 // (at most up to h_max) while the filters leave fewer than kMinimumFitPoints points or the largest
 // error is within six decades of the floor; or at
 // the `given` step sizes alone (varia verify --h). error_at(h) may adjust h (e.g. to whole steps to
-// a final time); a NumericalFailure at a step size drops that point, saying so.
+// a final time); a NumericalFailure at a step size drops that point, saying so. When given,
+// noise_at(h) is the round-off the error shows at h (which can grow as h shrinks: L_d near the
+// diagonal loses digits as |q1 - q0|); a point whose error is within it counts as at round-off.
 constexpr int kLadderPoints = 24;
 using ErrorAt = std::function<double(double& h)>;
+using NoiseAt = std::function<double(double h)>;
 OrderFit measure_order(const ErrorAt& error_at, double h_top, double h_max, double floor,
-                       const std::vector<double>& given);
+                       const std::vector<double>& given, const NoiseAt& noise_at = {});
 
 // A defect that should vanish (a self-adjointness, invariance or symplecticity residual, a drift
 // of a conserved quantity), measured at decreasing step sizes. It counts as zero when it stays
@@ -83,8 +86,9 @@ std::vector<SamplePair> sample_pairs(Manifold& manifold, const double* q, const 
 double self_adjointness_residual(DiscreteLagrangian& Ld, const std::vector<SamplePair>& pairs,
                                  double h);
 // The round-off of L_d at the pairs, measured: max |L_d(q0', q1') - L_d(q0, q1)| / |L_d| where q'
-// is q moved away and back (q exp(xi) exp(-xi)), equal to q but for round-off. The floor of the
-// two residuals below.
+// is q moved away and back (q exp(xi) exp(-xi)), equal to q but for round-off, or q1 moved by one
+// unit in the last place of each coordinate (near the diagonal L_d magnifies its endpoints'
+// rounding by |q| / |q1 - q0|). The floor of the residuals below and of ld_order's errors.
 double round_off_of(DiscreteLagrangian& Ld, Manifold& manifold, const std::vector<SamplePair>& pairs, double h);
 // max |L_d(g q0, g q1) - L_d(q0, q1)| / scale over pseudo-random g of the declared group.
 double invariance_residual(DiscreteLagrangian& Ld, Lagrangian& lagrangian,
