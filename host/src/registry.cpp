@@ -167,6 +167,18 @@ std::shared_ptr<boost::dll::shared_library> open_library(const fs::path& file) {
   return library;
 }
 
+// The typed properties of the metadata's "properties" object; a plugin declaring one with the
+// wrong type is refused.
+DeclaredProperties declared_properties(const nlohmann::json& properties) {
+  DeclaredProperties declared;
+  if (const auto it = properties.find("symplectic"); properties.is_object() && it != properties.end()) {
+    if (!it->is_boolean())
+      throw Refused{fmt::format("its properties declare \"symplectic\": {}, expected true or false", it->dump())};
+    declared.symplectic = it->get<bool>();
+  }
+  return declared;
+}
+
 // The ABI check comes before anything else is imported (Boost.DLL, doc/missuses.qbk).
 void check_abi(const boost::dll::shared_library& library) {
   if (!library.has("varia_abi_version"))
@@ -182,9 +194,10 @@ PluginRecord read_info(const boost::dll::shared_library& library, const fs::path
   if (info == nullptr || info->kind == nullptr || info->type == nullptr ||
       info->version == nullptr || info->parameter_schema == nullptr || info->properties == nullptr)
     throw Refused{"missing metadata (varia_info has an empty field)"};
-  return PluginRecord{file, info->kind, info->type, info->version,
-                      parameter_schema(info->parameter_schema),
-                      parse_metadata(info->properties, "properties")};
+  PluginRecord record{file, info->kind, info->type, info->version, parameter_schema(info->parameter_schema),
+                      parse_metadata(info->properties, "properties"), {}};
+  record.declared = declared_properties(record.properties);
+  return record;
 }
 
 }  // namespace

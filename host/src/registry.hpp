@@ -23,10 +23,18 @@
 
 namespace varia::host {
 
+// What a plugin declares in its metadata, read once when it is loaded. The properties the host
+// acts on are typed here (declared_properties() checks their types, refusing the plugin
+// otherwise); the whole object stays for `varia plugins`.
+struct DeclaredProperties {
+  bool symplectic = false;  // a one-step method's "symplectic" (in canonical coordinates)
+};
+
 struct PluginRecord {
   std::filesystem::path file;
   std::string kind, type, version;
   nlohmann::json parameter_schema, properties;
+  DeclaredProperties declared;
 };
 
 struct Refusal {

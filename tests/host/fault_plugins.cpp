@@ -54,6 +54,7 @@ TEST_CASE("plugins lists the good fault plugins and refuses each bad file with i
                                  std::to_string(kAbiVersion)},
       {"fault_no_metadata.so", "missing metadata (no varia_info)"},
       {"fault_bad_schema.so", "unusable parameter_schema in varia_info: "},
+      {"fault_bad_properties.so", "its properties declare \"symplectic\": \"yes\", expected true or false"},
   };
   const auto table = run_varia("plugins " + faults.flag());
   CAPTURE(table.out);

@@ -18,7 +18,7 @@ void apply_shared_theorems(const Assembly& a, std::optional<bool> ld_invariant, 
 void make_one_step(const Scene& scene, Registry& registry, Assembly& a) {
   a.one_step = make_part<OneStepMethod>(registry, *scene.one_step, scene, *a.manifold);
   a.one_step->set_solver(scene.solver.tolerance, scene.solver.max_iterations);
-  a.one_step_symplectic = registry.find(scene.one_step->kind, scene.one_step->type).properties.value("symplectic", false);
+  a.one_step_symplectic = registry.find(scene.one_step->kind, scene.one_step->type).declared.symplectic;
 }
 
 DeclaredMethod declared(const Assembly& a) {
