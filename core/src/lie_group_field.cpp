@@ -36,7 +36,12 @@ LieGroupField::LieGroupField(Manifold& manifold, LagrangianEvaluator& lagrangian
       y_jet_(m_ + n_),
       f_jet_(m_ + n_),
       momentum_(n_),
-      torque_(n_) {}
+      torque_(n_) {
+  if (!constant_mass_)
+    throw std::invalid_argument(
+        "one-step methods and the shooting construction on a Lie group need a Lagrangian with a constant inertia, "
+        "L = 1/2 xi^T J xi - V(g) (Lagrangian::constant_mass_matrix); this one declares none");
+}
 
 // dexp_{-xi} v = v - 1/2 [xi, v] + O(|xi|^2 |v|): the chart velocity's mixed second derivative
 // in (xi_a, v_b) at 0 is -1/2 [e_a, e_b].

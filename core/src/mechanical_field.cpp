@@ -18,16 +18,27 @@ void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian
 
 EulerLagrangeField::EulerLagrangeField(LagrangianEvaluator& lagrangian)
     : lagrangian_(lagrangian), n_(lagrangian.velocity_size()), mass_(n_, n_) {
-  if (!lagrangian.plugin().constant_mass_matrix(mass_.data()))
-    throw std::invalid_argument(
-        "one-step methods and the shooting construction need a Lagrangian with a constant mass "
-        "matrix, L = 1/2 v^T M v - V(q) (Lagrangian::constant_mass_matrix); this one declares "
-        "none");
-  inverse_mass_ = mass_.inverse();
+  constant_mass_ = lagrangian.plugin().constant_mass_matrix(mass_.data());
+  if (constant_mass_) inverse_mass_ = mass_.inverse();
 }
 
+namespace {
+
+LagrangianEvaluator& checked(LagrangianEvaluator& lagrangian, PhaseSpace space) {
+  Eigen::MatrixXd mass(lagrangian.velocity_size(), lagrangian.velocity_size());
+  if (space == PhaseSpace::tangent && !lagrangian.plugin().constant_mass_matrix(mass.data()))
+    throw std::invalid_argument(
+        "the tangent form (q, v) of the Euler-Lagrange field needs a Lagrangian with a constant mass matrix, "
+        "L = 1/2 v^T M v - V(q) (Lagrangian::constant_mass_matrix): with a configuration-dependent one its "
+        "derivatives need L's Hessian at jets, which the Lagrangian interface does not give; this one declares "
+        "none. Integrate in (q, p): the shooting construction's \"form\": \"hamiltonian\"");
+  return lagrangian;
+}
+
+}  // namespace
+
 MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space, Forces* forces)
-    : EulerLagrangeField(lagrangian),
+    : EulerLagrangeField(checked(lagrangian, space)),
       space_(space),
       forces_(forces != nullptr && !forces->empty() ? forces : nullptr),
       force_(n_),
@@ -39,8 +50,13 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       v_(n_),
       gradient_(2 * n_),
       hessian_(2 * n_, 2 * n_),
+      velocity_q_(n_, n_),
+      mass_lu_(n_),
       v_jet_(n_),
-      gradient_jet_(2 * n_) {}
+      gradient_jet_(2 * n_),
+      legendre_residual_(2 * n_) {
+  v_.setZero();
+}
 
 void EulerLagrangeField::inverse_mass(const double* w, double* x) const {
   Eigen::Map<Eigen::VectorXd>(x, n_).noalias() =
@@ -56,9 +72,52 @@ void EulerLagrangeField::inverse_mass(const Jet2* w, Jet2* x) const {
   }
 }
 
-void MechanicalField::velocity(const Jet2* w, Jet2* v) const {
-  if (space_ == PhaseSpace::cotangent) return inverse_mass(w, v);
-  std::copy(w, w + n_, v);
+// v(q, p) at jets. With a constant mass matrix M^{-1} p; otherwise Newton's method at jets on
+// dL/dv (q, v) = p from the value v(q.value, p.value), with the constant matrix L_vv there: the
+// iteration's error has no value part, and each iteration multiplies it by I - L_vv^{-1} L_vv(q,v),
+// whose value part is zero, so two iterations make the first and second derivatives exact.
+void MechanicalField::velocity(const Jet2* y, Jet2* v) {
+  const Jet2* w = y + n_;
+  if (space_ == PhaseSpace::tangent) {
+    std::copy(w, w + n_, v);
+    return;
+  }
+  if (constant_mass_) return inverse_mass(w, v);
+  const Jet2* q = point(y);
+  for (int r = 0; r < n_; ++r) {
+    position_[r] = q[r].value;
+    force_[r] = w[r].value;  // p's values (force_ as workspace)
+  }
+  velocity_of_momentum(position_.data(), force_.data());
+  lagrangian_.hessian(position_.data(), v_.data(), gradient_.data(), hessian_.data());
+  mass_lu_.compute(hessian_.bottomRightCorner(n_, n_));
+  velocity_q_ = mass_lu_.inverse();  // M^{-1} at the values
+  for (int r = 0; r < n_; ++r) v[r] = Jet2(v_[r]);
+  for (int iteration = 0; iteration < 2; ++iteration) {
+    lagrangian_.gradient_jet(q, v, nullptr, legendre_residual_.data());
+    for (int r = 0; r < n_; ++r) legendre_residual_[n_ + r] -= w[r];
+    for (int r = 0; r < n_; ++r) {
+      Jet2 update;
+      for (int c = 0; c < n_; ++c) {
+        const double a = velocity_q_(r, c);
+        if (a != 0.0) update += a * legendre_residual_[n_ + c];
+      }
+      v[r] -= update;
+    }
+  }
+}
+
+void MechanicalField::momentum(const double* q, const double* v, double* p) {
+  if (constant_mass_) {
+    Eigen::Map<Eigen::VectorXd>(p, n_).noalias() = mass_ * Eigen::Map<const Eigen::VectorXd>(v, n_);
+    return;
+  }
+  lagrangian_.legendre(q, v, p);
+}
+
+void MechanicalField::velocity_of_momentum(const double* q, const double* p) {
+  if (constant_mass_) return inverse_mass(p, v_.data());
+  lagrangian_.inverse_legendre(q, p, v_.data(), legendre_options_);
 }
 
 const double* MechanicalField::point(const double* y) {
@@ -98,9 +157,9 @@ void MechanicalField::force(const Jet2* state, const Jet2* v, Jet2* f) {
 
 Status MechanicalField::eval(const double* y, double* f) noexcept {
   return guard([&] {
-    if (space_ == PhaseSpace::cotangent) inverse_mass(y + n_, v_.data());
-    else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
     const double* q = point(y);
+    if (space_ == PhaseSpace::cotangent) velocity_of_momentum(q, y + n_);
+    else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
     lagrangian_.gradient(q, v_.data(), gradient_.data());
     if (forced_) add_forces(y, q, false);
     Eigen::Map<Eigen::VectorXd>(f, n_) = v_;
@@ -112,7 +171,7 @@ Status MechanicalField::eval(const double* y, double* f) noexcept {
 
 Status MechanicalField::eval(const Jet2* y, Jet2* f) noexcept {
   return guard([&] {
-    velocity(y + n_, v_jet_.data());
+    velocity(y, v_jet_.data());
     lagrangian_.gradient_jet(point(y), v_jet_.data(), nullptr, gradient_jet_.data());
     if (forced_) {
       force(y, v_jet_.data(), force_jet_.data());
@@ -126,16 +185,17 @@ Status MechanicalField::eval(const Jet2* y, Jet2* f) noexcept {
 }
 
 // Tangent:   df = [0, I; M^{-1} L_qq, M^{-1} L_qv].
-// Cotangent: df = [0, M^{-1}; L_qq, L_qv M^{-1}]  (v = M^{-1} p).
+// Cotangent: df = [0, M^{-1}; L_qq, L_qv M^{-1}]  (v = M^{-1} p); with a configuration-dependent
+// mass matrix M = L_vv (q, v), cotangent_jacobian().
 // With forces, L_q + f in place of L_q, and the time's row and column zero: t' = 1 is constant,
 // and df/dt (which the Force interface does not give) multiplies only the time's Newton update,
 // which is zero once the stages' times are right (after the first update of an implicit stage
 // solve; the values at convergence and the jets are exact).
 Status MechanicalField::jacobian(const double* y, double* f, double* df) noexcept {
   return guard([&] {
-    if (space_ == PhaseSpace::cotangent) inverse_mass(y + n_, v_.data());
-    else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
     const double* q = point(y);
+    if (space_ == PhaseSpace::cotangent) velocity_of_momentum(q, y + n_);
+    else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
     lagrangian_.hessian(q, v_.data(), gradient_.data(), hessian_.data());
     if (forced_) add_forces(y, q, true);
     const int N = size();
@@ -143,7 +203,10 @@ Status MechanicalField::jacobian(const double* y, double* f, double* df) noexcep
     Eigen::Map<Eigen::MatrixXd> J(df, N, N);
     J.setZero();
     rate.head(n_) = v_;
-    if (space_ == PhaseSpace::cotangent) {
+    if (space_ == PhaseSpace::cotangent && !constant_mass_) {
+      rate.segment(n_, n_) = gradient_.head(n_);
+      cotangent_jacobian(J.topLeftCorner(2 * n_, 2 * n_));
+    } else if (space_ == PhaseSpace::cotangent) {
       rate.segment(n_, n_) = gradient_.head(n_);
       J.block(0, n_, n_, n_) = inverse_mass_;
       J.block(n_, 0, n_, n_) = hessian_.topLeftCorner(n_, n_);
@@ -156,6 +219,19 @@ Status MechanicalField::jacobian(const double* y, double* f, double* df) noexcep
     }
     if (clock()) rate[2 * n_] = 1.0;
   });
+}
+
+// v = v(q, p) solves L_v(q, v) = p: v_p = M^{-1}, v_q = -M^{-1} L_vq (M = L_vv); the momentum's
+// rate g = L_q + f (hessian_'s first n rows hold its derivatives in (q, v)) has
+// g_q + g_v v_q and g_v v_p.
+void MechanicalField::cotangent_jacobian(Eigen::Ref<Eigen::MatrixXd> J) {
+  mass_lu_.compute(hessian_.bottomRightCorner(n_, n_));
+  J.block(0, n_, n_, n_) = mass_lu_.inverse();
+  velocity_q_.noalias() = -J.block(0, n_, n_, n_) * hessian_.bottomLeftCorner(n_, n_);
+  J.block(0, 0, n_, n_) = velocity_q_;
+  J.block(n_, 0, n_, n_) = hessian_.topLeftCorner(n_, n_);
+  J.block(n_, 0, n_, n_).noalias() += hessian_.topRightCorner(n_, n_) * velocity_q_;
+  J.block(n_, n_, n_, n_).noalias() = hessian_.topRightCorner(n_, n_) * J.block(0, n_, n_, n_);
 }
 
 namespace {

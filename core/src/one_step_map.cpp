@@ -6,12 +6,15 @@ namespace varia {
 
 namespace {
 
-// The Euler-Lagrange field of the manifold's phase space, y = (q, v).
-std::unique_ptr<EulerLagrangeField> tangent_field(Manifold& manifold,
-                                                  LagrangianEvaluator& lagrangian) {
+// The Euler-Lagrange field the method integrates: on a Lie group the Euler-Poincare field in
+// (g, xi); on R^n in (q, v) for a constant mass matrix, else Hamilton's equations in (q, p)
+// (mechanical_field.hpp), where a symplectic Runge-Kutta method is symplectic.
+std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvaluator& lagrangian) {
   if (!manifold.is_vector_space()) return std::make_unique<LieGroupField>(manifold, lagrangian);
   require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");
-  return std::make_unique<MechanicalField>(lagrangian, PhaseSpace::tangent);
+  std::vector<double> mass(static_cast<std::size_t>(lagrangian.velocity_size() * lagrangian.velocity_size()));
+  const bool constant = lagrangian.plugin().constant_mass_matrix(mass.data());
+  return std::make_unique<MechanicalField>(lagrangian, constant ? PhaseSpace::tangent : PhaseSpace::cotangent);
 }
 
 }  // namespace
@@ -19,7 +22,7 @@ std::unique_ptr<EulerLagrangeField> tangent_field(Manifold& manifold,
 OneStepHamiltonianMap::OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian,
                                              OneStepMethod& method, SolverOptions options)
     : lagrangian_(lagrangian),
-      field_(tangent_field(manifold, lagrangian_)),
+      field_(field_of(manifold, lagrangian_)),
       method_(method),
       m_(manifold.point_size()),
       n_(manifold.dim()),
@@ -31,10 +34,12 @@ OneStepHamiltonianMap::OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lag
 void OneStepHamiltonianMap::take_step(const double* q0, const double* p0, double /*t0*/, double h, double* q1,
                                       double* p1) {
   y0_.head(m_) = Eigen::Map<const Eigen::VectorXd>(q0, m_);
-  field_->inverse_mass(p0, y0_.data() + m_);
+  if (field_->constant_mass()) field_->inverse_mass(p0, y0_.data() + m_);
+  else y0_.tail(n_) = Eigen::Map<const Eigen::VectorXd>(p0, n_);
   field_->step(method_, h, y0_.data(), y1_.data(), statistics_);
   Eigen::Map<Eigen::VectorXd>(q1, m_) = y1_.head(m_);
-  Eigen::Map<Eigen::VectorXd>(p1, n_).noalias() = field_->mass() * y1_.tail(n_);
+  if (field_->constant_mass()) Eigen::Map<Eigen::VectorXd>(p1, n_).noalias() = field_->mass() * y1_.tail(n_);
+  else Eigen::Map<Eigen::VectorXd>(p1, n_) = y1_.tail(n_);
 }
 
 }  // namespace varia

@@ -99,9 +99,10 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   if (!forces_.empty() && type_2())
     throw std::invalid_argument("the shooting construction takes forces in the lagrangian and "
                                 "hamiltonian forms (Type I generating functions), not type-2");
-  if ((!forces_.empty() || mechanical_ == nullptr) && (start_correction_ != 0.0 || end_correction_ != 0.0))
+  if ((!forces_.empty() || mechanical_ == nullptr || !field_->constant_mass()) &&
+      (start_correction_ != 0.0 || end_correction_ != 0.0))
     throw std::invalid_argument("the shooting construction takes end-derivative quadratures on vector spaces "
-                                "without forces only");
+                                "without forces, for a Lagrangian with a constant mass matrix, only");
   state_.resize(field_->size());
   next_.resize(field_->size());
   target_.resize(m_);
@@ -120,6 +121,7 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   local_gradient_.resize(n_ * m_);
   local_hessian_.resize(n_ * m_ * m_);
   w_.resize(n_);
+  v_values_.resize(n_);
   lambda_.resize(n_);
   D1_.resize(n_);
   residual_.resize(n_);
@@ -151,7 +153,7 @@ void ShootingDiscreteLagrangian::accumulate(int node, double h, Jet2& S) {
   const bool first = node == 0, last = node + 1 == static_cast<int>(nodes_.size());
   const double correction = first ? start_correction_ : last ? end_correction_ : 0.0;
   if (weights_[node] == 0.0 && correction == 0.0) return;
-  if (mechanical_ != nullptr) mechanical_->velocity(&state_[m_], v_.data());
+  if (mechanical_ != nullptr) mechanical_->velocity(state_.data(), v_.data());
   else std::copy_n(state_.begin() + m_, n_, v_.begin());
   Jet2 L;
   lagrangian_.gradient_jet(position(), v_.data(), &L, gradient_.data());
@@ -427,7 +429,10 @@ void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
   forced_ = false;  // L_d alone: the forces are not part of it
   check(manifold_, manifold_.local(q0, q1, w_.data()), "manifold chart");
   w_ /= h;
-  if (form_ != ShootingForm::lagrangian) w_ = field_->mass() * w_;
+  if (form_ != ShootingForm::lagrangian) {  // p0's guess: the momentum of that velocity at q0
+    v_values_ = w_;
+    mechanical_->momentum(q0, v_values_.data(), w_.data());
+  }
   target_is_end_ = false;
   std::copy_n(q1, m_, target_.begin());
   // On a vector space B = q^n - q0 against q1 - q0 (type-2: lambda against q1); through the chart

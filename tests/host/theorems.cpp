@@ -376,3 +376,41 @@ TEST_CASE("verify --h sets the step sizes of the order fits (issue #17, defect 1
   CHECK(*v["global_order"].measured == doctest::Approx(2.0).epsilon(0.05));
   CHECK(v["global_order"].note.find("5 points fitted") != std::string::npos);
 }
+
+TEST_CASE("a configuration-dependent mass matrix (the double pendulum): shooting in the hamiltonian form and one-step "
+          "gauss collocation integrate (q, p) and measure their predicted orders and symplecticity against a galerkin "
+          "reference; the lagrangian form is refused at /method (issue #18: both were refused)") {
+  json scene = bundled_scene("hard/double-pendulum.json");
+  scene["initial"] = {{"q", {1.0, 0.5}}, {"v", {0.0, 0.0}}};
+  scene["steps"] = 100;
+  scene.erase("output");
+  const json shooting{{"construction", "shooting"},
+                      {"form", "hamiltonian"},
+                      {"one_step", {{"type", "gauss-collocation"}, {"stages", 2}}},
+                      {"quadrature", {{"type", "gauss-lobatto"}, {"points", 3}}}};
+  const json one_step{{"construction", "one-step"}, {"one_step", {{"type", "gauss-collocation"}, {"stages", 2}}}};
+  for (const json& method : {shooting, one_step}) {
+    CAPTURE(method.dump());
+    scene["method"] = method;
+    const Verified v(scene);
+    for (const auto& c : v.checks) {
+      CAPTURE(c.name);
+      CAPTURE(c.note);
+      CHECK_FALSE(c.failed());
+      CHECK_FALSE(c.unmeasured());
+    }
+    REQUIRE(v["global_order"].measured);
+    CHECK(*v["global_order"].measured >= 4 - 0.3);
+    CHECK(v["symplectic"].predicted == true);
+    CHECK(v["symplectic"].holds == true);
+  }
+  scene["method"] = {{"construction", "shooting"}, {"one_step", {{"type", "rk4"}}}, {"quadrature", {{"type", "simpson"}}}};
+  std::string message;
+  try {
+    Verified refused(scene);
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  CHECK(message.rfind("/method", 0) == 0);
+  CHECK(message.find("\"form\": \"hamiltonian\"") != std::string::npos);
+}

@@ -1,17 +1,25 @@
 // The vector field that a one-step method integrates for the shooting construction (paper,
-// sec. 3), for a Lagrangian L = 1/2 v^T M v - V(q) with a constant mass matrix M on R^n:
-//   tangent form (q, v):    q' = v,        v' = M^{-1} dL/dq (q, v)   (Euler-Lagrange),
-//   cotangent form (q, p):  q' = M^{-1} p, p' = dL/dq (q, M^{-1} p)   (Hamilton's equations of
-//                           the Legendre transform H(q, p) = <p, v> - L(q, v), v = M^{-1} p,
-//                           paper, sec. 3 "Generalizations").
+// sec. 3) and the one-step construction, on R^n:
+//   tangent form (q, v):    q' = v,        v' = M^{-1} dL/dq (q, v)   (Euler-Lagrange, for a
+//                           Lagrangian L = 1/2 v^T M v - V(q) with a constant mass matrix M),
+//   cotangent form (q, p):  q' = v(q, p),  p' = dL/dq (q, v(q, p))    (Hamilton's equations of
+//                           the Legendre transform H(q, p) = <p, v> - L(q, v), dL/dv (q, v) = p,
+//                           paper, sec. 3 "Generalizations"), for any regular Lagrangian: v(q, p)
+//                           is M^{-1} p for a constant mass matrix, else the exact inverse Legendre
+//                           transform, solved by Newton's method at doubles and at jets.
+// The cotangent form needs L's derivatives to second order for the field's Jacobian and to third
+// order for its second-order jets, which dL/dv at jets gives; the tangent form of a
+// configuration-dependent mass matrix would need L's Hessian at jets, which the Lagrangian
+// interface does not give, and is refused.
 // With forces f(t, q, v) (force.hpp) the field is that of the forced Euler-Lagrange equations,
 // d/dt dL/dv - dL/dq = f (Marsden & West 2001, sec. 3.2): M v' = L_q + f, or p' = L_q + f; the
 // time is then the state's last number, t' = 1 (the methods integrate autonomous fields).
-// The acceleration comes from L's exact derivatives, at doubles and at jets. The field also
+// The field's values come from L's exact derivatives, at doubles and at jets. The field also
 // drives one step of a one-step plugin, turning its Status into the right exception.
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <exception>
 #include <string>
 #include <vector>
@@ -31,14 +39,15 @@ enum class PhaseSpace { tangent, cotangent };
 void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian,
                           const char* construction);
 
-// The Euler-Lagrange vector field of a Lagrangian L = 1/2 v^T M v - V(q) with a constant mass
-// matrix M, on a state y = (q, w): q the point (point_size numbers), w the velocity or momentum.
-// It drives one step of a one-step plugin, turning its Status into the right exception; the
-// derived fields give f for their phase space.
+// The Euler-Lagrange vector field of a Lagrangian on a state y = (q, w): q the point (point_size
+// numbers), w the velocity or momentum. It drives one step of a one-step plugin, turning its
+// Status into the right exception; the derived fields give f for their phase space.
 class EulerLagrangeField : public VectorField {
  public:
-  // Throws std::invalid_argument unless the Lagrangian declares a constant mass matrix.
+  // mass() and inverse_mass() are those of a Lagrangian declaring a constant mass matrix
+  // (constant_mass()); the derived fields that need one refuse the others.
   explicit EulerLagrangeField(LagrangianEvaluator& lagrangian);
+  bool constant_mass() const { return constant_mass_; }
 
   // y1 = Psi_h(y0) by `method`, its stage iterations recorded in `stages`. Throws
   // NumericalFailure (stage equations that do not converge, a non-finite state) or PluginFault.
@@ -69,6 +78,7 @@ class EulerLagrangeField : public VectorField {
 
   LagrangianEvaluator& lagrangian_;
   int n_;
+  bool constant_mass_;
   Eigen::MatrixXd mass_, inverse_mass_;
 
  private:
@@ -82,16 +92,19 @@ class EulerLagrangeField : public VectorField {
 // On R^n: y = (q, v) or (q, p), N = 2n; with forces y = (q, v, t) or (q, p, t), N = 2n + 1.
 class MechanicalField final : public EulerLagrangeField {
  public:
-  // Throws std::invalid_argument unless the Lagrangian declares a constant mass matrix. The forces
-  // (may be null or empty: none) are applied while forced() is on.
+  // The tangent form throws std::invalid_argument unless the Lagrangian declares a constant mass
+  // matrix. The forces (may be null or empty: none) are applied while forced() is on.
   MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space, Forces* forces = nullptr);
   int size() const noexcept override { return 2 * n_ + (clock() ? 1 : 0); }
   Status eval(const double* y, double* f) noexcept override;
   Status eval(const Jet2* y, Jet2* f) noexcept override;
   Status jacobian(const double* y, double* f, double* df) noexcept override;
 
-  // The velocity of a state's second half: v = w (tangent) or M^{-1} w (cotangent).
-  void velocity(const Jet2* w, Jet2* v) const;
+  // The velocity of state y: v = w (tangent) or v(q, w) (cotangent: M^{-1} w, or the inverse
+  // Legendre transform at jets).
+  void velocity(const Jet2* y, Jet2* v);
+  // p = dL/dv (q, v) at doubles: the momentum of a velocity (a Newton guess on the cotangent side).
+  void momentum(const double* q, const double* v, double* p);
 
   // The state's positions as offsets from `origin` (n jets, kept by the caller; null: none): the
   // field is evaluated at origin + offset. Every Runge-Kutta method commutes with the translation,
@@ -115,6 +128,11 @@ class MechanicalField final : public EulerLagrangeField {
   // `jacobian` their Jacobian to the rows of hessian_ (d(L_q + f)/d(q, v)).
   void add_forces(const double* y, const double* q, bool jacobian);
   const double* point(const double* y);
+  // v_ = v(q, p) at doubles: M^{-1} p, or the inverse Legendre transform from the last v_.
+  void velocity_of_momentum(const double* q, const double* p);
+  // The cotangent form's Jacobian [v_q, v_p; (L_q + f)_q + (L_q + f)_v v_q, (L_q + f)_v v_p] from
+  // hessian_ (with the forces' rows), v_q = -M^{-1} L_vq and v_p = M^{-1} at (q, v_).
+  void cotangent_jacobian(Eigen::Ref<Eigen::MatrixXd> J);
 
   PhaseSpace space_;
   Forces* forces_;
@@ -126,8 +144,10 @@ class MechanicalField final : public EulerLagrangeField {
   std::vector<Jet2> force_jet_;
   // Workspace, sized once.
   Eigen::VectorXd v_, gradient_;
-  Eigen::MatrixXd hessian_;
-  std::vector<Jet2> v_jet_, gradient_jet_;
+  Eigen::MatrixXd hessian_, velocity_q_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> mass_lu_;  // L_vv at the last state (not constant_mass())
+  std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;
+  SolverOptions legendre_options_;
 };
 
 }  // namespace varia

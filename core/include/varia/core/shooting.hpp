@@ -54,7 +54,8 @@
 // quadratures there.
 //
 // Restrictions: a manifold of dimension n <= 6 (jets of 2n <= kMaxJetVariables = 12 variables:
-// SE(3)) and a Lagrangian with a constant mass matrix (mechanical_field.hpp).
+// SE(3)); the lagrangian form needs a Lagrangian with a constant mass matrix, the hamiltonian and
+// type-2 forms take any regular one (mechanical_field.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -154,7 +155,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // The natural chart's derivatives (Manifold::chart, local_derivatives), component-major.
   std::vector<double> end_, chart_value_, chart_gradient_, chart_hessian_, local_value_, local_gradient_,
       local_hessian_;
-  Eigen::VectorXd w_, lambda_, D1_, residual_;
+  Eigen::VectorXd w_, v_values_, lambda_, D1_, residual_;
   Eigen::VectorXd alpha_;        // G_x + W_x: the forced 1-form in x = (q0, w0)
   Eigen::MatrixXd work_jacobian_;  // dW_x/dx
   Eigen::MatrixXd Bq_, Bw_, phi_, jacobian_;
