@@ -57,8 +57,8 @@ class QuadraticForce final : public varia::sdk::ForceBase {
 
 TEST_CASE("varia-conformance: every bundled effect and force plugin conforms, by the Taylor tests of its "
           "derivatives") {
-  for (const char* name : {"effect_gravity.so", "effect_spring.so", "effect_central.so", "force_damping.so",
-                           "force_periodic_force.so"}) {
+  for (const char* name : {"effect_gravity.so", "effect_spring.so", "effect_central.so", "effect_gravitation.so",
+                           "force_damping.so", "force_periodic_force.so"}) {
     const Outcome outcome = conformance(bundled(name));
     CAPTURE(outcome.out);
     CHECK(outcome.code == 0);
