@@ -25,22 +25,11 @@ CompositeLagrangian::CompositeLagrangian(int space_dim, std::vector<double> mass
     : d_(space_dim), masses_(per_coordinate(masses, space_dim)) {
   n_ = static_cast<int>(masses_.size());
   // The kinetic energy's Hessian: d2L/dv_j^2 = m_j, at slots 0 .. n-1.
-  Slots slots;
-  for (int j = 0; j < n_; ++j) slot(n_ + j, n_ + j, slots);
-  for (std::size_t e = 0; e < effects.size(); ++e) terms_.push_back(bind(std::move(effects[e]), e, slots));
+  for (int j = 0; j < n_; ++j) pattern_.slot(n_ + j, n_ + j);
+  for (std::size_t e = 0; e < effects.size(); ++e) terms_.push_back(bind(std::move(effects[e]), e));
 }
 
-int CompositeLagrangian::slot(int row, int col, Slots& slots) {
-  const auto [it, inserted] = slots.try_emplace({row, col}, static_cast<int>(rows_.size()));
-  if (inserted) {
-    rows_.push_back(row);
-    cols_.push_back(col);
-  }
-  return it->second;
-}
-
-CompositeLagrangian::Term CompositeLagrangian::bind(std::shared_ptr<Effect> effect, std::size_t index,
-                                                    Slots& slots) {
+CompositeLagrangian::Term CompositeLagrangian::bind(std::shared_ptr<Effect> effect, std::size_t index) {
   const int particles = n_ / d_;
   std::vector<double> masses(particles);
   for (int i = 0; i < particles; ++i) masses[i] = masses_[i * d_];
@@ -53,7 +42,7 @@ CompositeLagrangian::Term CompositeLagrangian::bind(std::shared_ptr<Effect> effe
       throw std::invalid_argument(where + "the effect names a coordinate outside q");
   const int *rows = nullptr, *cols = nullptr;
   const int entries = effect->hessian_pattern(&rows, &cols);
-  for (int e = 0; e < entries; ++e) term.slots.push_back(slot(term.indices[rows[e]], term.indices[cols[e]], slots));
+  for (int e = 0; e < entries; ++e) term.slots.push_back(pattern_.slot(term.indices[rows[e]], term.indices[cols[e]]));
   term.x.resize(k);
   term.gradient.resize(k);
   term.hessian.resize(entries);
@@ -93,7 +82,7 @@ Status CompositeLagrangian::evaluate(const double* q, const double* v, double* v
       for (int j = 0; j < n_; ++j) gradient[n_ + j] = masses_[j] * v[j];
     }
     if (hessian != nullptr) {
-      std::fill(hessian + n_, hessian + rows_.size(), 0.0);
+      std::fill(hessian + n_, hessian + pattern_.size(), 0.0);
       std::copy(masses_.begin(), masses_.end(), hessian);
     }
     for (Term& term : terms_) add_term(term, q, value, gradient, hessian);
@@ -105,9 +94,7 @@ Status CompositeLagrangian::evaluate(const double* q, const double* v, double* v
 }
 
 int CompositeLagrangian::hessian_pattern(const int** rows, const int** cols) const noexcept {
-  *rows = rows_.data();
-  *cols = cols_.data();
-  return static_cast<int>(rows_.size());
+  return pattern_.entries(rows, cols);
 }
 
 bool CompositeLagrangian::constant_mass_matrix(double* mass) const noexcept {

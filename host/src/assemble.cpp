@@ -34,6 +34,23 @@ void check_lagrangian_fits(const Scene& scene, const Lagrangian& lagrangian, con
       manifold.point_size(), manifold.dim()));
 }
 
+// A Lagrangian without a Hessian pattern is dense: the evaluator holds its (m + n)^2 Hessian and
+// the constructions' Newton matrices grow as the square of the unknowns, so its size is bounded
+// (docs/writing-plugins.md, "What still limits the size"). A large system is written as a sum of
+// terms (sdk::TermwiseLagrangian) or as a composite, whose Hessians are sparse.
+constexpr long kMaxDenseNumbers = 4096;
+
+void check_dense_size(const Scene& scene, const Lagrangian& lagrangian) {
+  const int *rows = nullptr, *cols = nullptr;
+  const long k = static_cast<long>(lagrangian.position_size()) + lagrangian.velocity_size();
+  if (k <= kMaxDenseNumbers || lagrangian.hessian_pattern(&rows, &cols) >= 0) return;
+  throw InputError(fmt::format(
+      "{}: the {} Lagrangian has a dense Hessian over its {} position and velocity numbers, and at most {} are "
+      "taken (the Hessian and the Newton matrices grow as the square: {:.0f} MB for this Hessian alone); write "
+      "it as a sum of terms (sdk::TermwiseLagrangian) or as a composite system, whose Hessians are sparse",
+      scene.lagrangian.pointer, scene.lagrangian.type, k, kMaxDenseNumbers, 8e-6 * static_cast<double>(k * k)));
+}
+
 // Spec "observe": momentum needs a declared symmetry; orthogonality a manifold embedded with a
 // constraint (the rotation matrix of SO3 and SE3: Manifold::has_constraint).
 void check_observables(const Scene& scene, Lagrangian& lagrangian, const Manifold& manifold) {
@@ -103,6 +120,7 @@ Assembly assemble(const Scene& scene, Registry& registry) {
   check_initial_state(scene, *a.manifold, scene.manifold.type);
   a.lagrangian = lagrangian(scene, registry, *a.manifold);
   check_lagrangian_fits(scene, *a.lagrangian, *a.manifold);
+  check_dense_size(scene, *a.lagrangian);
   check_observables(scene, *a.lagrangian, *a.manifold);
   create_forces(scene, registry, a);
   scene.construction->build(scene, registry, a);

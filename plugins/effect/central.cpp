@@ -3,11 +3,11 @@
 #include <cmath>
 
 #include "../lagrangian/support.hpp"
-#include "support.hpp"
+#include "varia/sdk/particle_effect.hpp"
 
 namespace {
 
-class Central final : public varia::plugins::ParticleEffect {
+class Central final : public varia::sdk::ParticleEffect {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -20,6 +20,7 @@ class Central final : public varia::plugins::ParticleEffect {
                  "description": "the fixed center c, space_dim numbers (default: the origin)"}
     },
     "required": ["particle"],
+    "examples": [{"particle": 2}, {"particle": 1, "mu": 2, "center": [0.5, -1.0, 0.2]}],
     "additionalProperties": false
   })json";
   static constexpr const char* properties = R"json({
@@ -29,8 +30,8 @@ class Central final : public varia::plugins::ParticleEffect {
 
   Central(const nlohmann::json& parameters, const varia::sdk::Context&)
       : mu_(varia::plugins::positive_parameter(parameters, "mu", 1.0)),
-        particle_(varia::plugins::particle_index(parameters.at("particle"), "particle")),
-        center_(varia::plugins::vector_parameter(parameters, "center")) {}
+        particle_(varia::sdk::particle_index(parameters.at("particle"), "particle")),
+        center_(varia::sdk::vector_parameter(parameters, "center")) {}
 
  private:
   void attach() override {

@@ -1,10 +1,10 @@
 // Uniform gravity on every particle: V = -sum_i m_i <g, x_i>, so m_i x_i'' = m_i g. Its Hessian
 // is zero: no entries.
-#include "support.hpp"
+#include "varia/sdk/particle_effect.hpp"
 
 namespace {
 
-class Gravity final : public varia::plugins::ParticleEffect {
+class Gravity final : public varia::sdk::ParticleEffect {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -15,6 +15,7 @@ class Gravity final : public varia::plugins::ParticleEffect {
             "description": "the acceleration of gravity, a space_dim-vector"}
     },
     "required": ["g"],
+    "examples": [{"g": [-1.0]}, {"g": [0.0, -9.81]}, {"g": [0.0, 0.5, -9.81]}],
     "additionalProperties": false
   })json";
   static constexpr const char* properties = R"json({
@@ -23,7 +24,7 @@ class Gravity final : public varia::plugins::ParticleEffect {
   })json";
 
   Gravity(const nlohmann::json& parameters, const varia::sdk::Context&)
-      : g_(varia::plugins::vector_parameter(parameters, "g")) {}
+      : g_(varia::sdk::vector_parameter(parameters, "g")) {}
 
  private:
   void attach() override {

@@ -5,11 +5,11 @@
 #include <cmath>
 
 #include "../lagrangian/support.hpp"
-#include "support.hpp"
+#include "varia/sdk/particle_effect.hpp"
 
 namespace {
 
-class Spring final : public varia::plugins::ParticleEffect {
+class Spring final : public varia::sdk::ParticleEffect {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -28,6 +28,9 @@ class Spring final : public varia::plugins::ParticleEffect {
       {"required": ["between"], "not": {"anyOf": [{"required": ["anchor"]}, {"required": ["particle"]}]}},
       {"required": ["anchor", "particle"], "not": {"required": ["between"]}}
     ],
+    "examples": [{"between": [0, 2], "stiffness": 3, "rest_length": 0.7}, {"between": [3, 1]},
+                 {"anchor": [0.1], "particle": 1, "stiffness": 2, "rest_length": 0.2},
+                 {"anchor": [0.1, 0.2, 0.3], "particle": 1, "stiffness": 2, "rest_length": 0.2}],
     "additionalProperties": false
   })json";
   static constexpr const char* properties = R"json({
@@ -38,16 +41,16 @@ class Spring final : public varia::plugins::ParticleEffect {
   Spring(const nlohmann::json& parameters, const varia::sdk::Context&)
       : k_(varia::plugins::positive_parameter(parameters, "stiffness", 1.0)),
         r_(parameters.value("rest_length", 0.0)),
-        anchor_(varia::plugins::vector_parameter(parameters, "anchor")) {
+        anchor_(varia::sdk::vector_parameter(parameters, "anchor")) {
     if (!(r_ >= 0)) throw std::invalid_argument("parameter 'rest_length' must be >= 0");
     if (parameters.contains("between")) {
       const auto& between = parameters.at("between");
       if (!between.is_array() || between.size() != 2)
         throw std::invalid_argument("parameter 'between' must be two particle indices");
-      ends_ = {varia::plugins::particle_index(between[0], "between"), varia::plugins::particle_index(between[1], "between")};
+      ends_ = {varia::sdk::particle_index(between[0], "between"), varia::sdk::particle_index(between[1], "between")};
       if (ends_[0] == ends_[1]) throw std::invalid_argument("parameter 'between' must name two different particles");
     } else if (parameters.contains("anchor") && parameters.contains("particle")) {
-      ends_ = {varia::plugins::particle_index(parameters.at("particle"), "particle")};
+      ends_ = {varia::sdk::particle_index(parameters.at("particle"), "particle")};
     } else {
       throw std::invalid_argument("a spring needs 'between', or 'anchor' and 'particle'");
     }

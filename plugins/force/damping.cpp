@@ -1,11 +1,11 @@
 // Linear (Rayleigh) damping f = -c v (spec: "Composed systems: effects"); df/dv = -c I.
 #include <stdexcept>
 
-#include "support.hpp"
+#include "varia/sdk/force_base.hpp"
 
 namespace {
 
-class Damping final : public varia::plugins::ForceBase {
+class Damping final : public varia::sdk::ForceBase {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -14,6 +14,7 @@ class Damping final : public varia::plugins::ForceBase {
     "properties": {
       "coefficient": {"type": "number", "minimum": 0, "default": 1, "description": "c in f = -c v"}
     },
+    "examples": [{"coefficient": 0.3}],
     "additionalProperties": false
   })json";
   static constexpr const char* properties = R"json({

@@ -4,11 +4,11 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "support.hpp"
+#include "varia/sdk/force_base.hpp"
 
 namespace {
 
-class PeriodicForce final : public varia::plugins::ForceBase {
+class PeriodicForce final : public varia::sdk::ForceBase {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -20,6 +20,8 @@ class PeriodicForce final : public varia::plugins::ForceBase {
       "frequency": {"type": "number", "default": 1, "description": "w in f = A cos(w t) (angular)"}
     },
     "required": ["amplitude"],
+    "examples": [{"amplitude": [0.5], "frequency": 1.3}, {"amplitude": [0.5, -0.2], "frequency": 2},
+                 {"amplitude": [0.5, -0.2, 0.1]}, {"amplitude": [1, 2, 3, 4], "frequency": 0.7}],
     "additionalProperties": false
   })json";
   static constexpr const char* properties = R"json({

@@ -24,7 +24,7 @@ class HarmonicOscillator final : public varia::sdk::AutodiffLagrangian<HarmonicO
   static constexpr const char* properties = R"json({
     "lagrangian": "m/2 |v|^2 - k/2 |q|^2",
     "energy": "m/2 |v|^2 + k/2 |q|^2",
-    "manifold": "Rn, dim 1 to 8",
+    "manifold": "Rn, any dim",
     "symmetry": "none",
     "momentum_map": null,
     "exact_solution": true
@@ -62,10 +62,8 @@ class HarmonicOscillator final : public varia::sdk::AutodiffLagrangian<HarmonicO
   }
 
  private:
-  // n <= 8: q and v together fit the autodiff capacity (varia::sdk::kMaxAutodiffVariables).
   static int dimension(const varia::sdk::Context& context) {
-    varia::plugins::require_rn(context, "harmonic-oscillator", 1,
-                               varia::sdk::kMaxAutodiffVariables / 2);
+    varia::plugins::require_rn(context, "harmonic-oscillator", 1, varia::plugins::kAnyDim);
     return context.dim;
   }
 

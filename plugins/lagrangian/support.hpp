@@ -2,6 +2,7 @@
 // do not support, and writing the constant mass matrix c I of L = c/2 |v|^2 - V(q).
 #pragma once
 
+#include <limits>
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
@@ -22,12 +23,15 @@ inline double positive_parameter(const nlohmann::json& parameters, const char* k
   return value.get<double>();
 }
 
+// No upper bound on the dimension (require_rn).
+inline constexpr int kAnyDim = std::numeric_limits<int>::max();
+
 // Throws unless the manifold is Rn with min_dim <= dim <= max_dim, naming what `type` needs.
 inline void require_rn(const sdk::Context& context, const char* type, int min_dim, int max_dim) {
   if (context.manifold == "Rn" && context.dim >= min_dim && context.dim <= max_dim) return;
-  const std::string dims = min_dim == max_dim
-                               ? std::to_string(min_dim)
-                               : std::to_string(min_dim) + " to " + std::to_string(max_dim);
+  const std::string dims = min_dim == max_dim    ? std::to_string(min_dim)
+                           : max_dim == kAnyDim ? ">= " + std::to_string(min_dim)
+                                                : std::to_string(min_dim) + " to " + std::to_string(max_dim);
   throw std::invalid_argument(std::string(type) + " needs manifold Rn with dim " + dims + ", got " +
                               context.manifold + " with dim " + std::to_string(context.dim));
 }

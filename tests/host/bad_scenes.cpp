@@ -5,7 +5,9 @@
 
 #include <fstream>
 #include <map>
+#include <nlohmann/json.hpp>
 #include <string>
+#include <vector>
 
 #include "host/support.hpp"
 #include "errors.hpp"
@@ -114,6 +116,30 @@ TEST_CASE("a scene file larger than 16 MiB is refused before it is read whole, e
     out << "\"}";
   }
   check_bad_scene(file, "the file is larger than 16 MiB");
+}
+
+// A harmonic oscillator (a dense autodiff Lagrangian) on Rn with dim n, integrated by Stormer-Verlet.
+std::string dense_oscillator_scene(int n) {
+  const nlohmann::json scene{
+      {"system", {{"manifold", {{"type", "Rn"}, {"dim", n}}}, {"lagrangian", {{"type", "harmonic-oscillator"}}}}},
+      {"method", {{"construction", "galerkin"}, {"degree", 1}, {"quadrature", {{"type", "trapezoid"}}}}},
+      {"initial", {{"q", std::vector<double>(n, 0.1)}, {"p", std::vector<double>(n, 0.0)}}},
+      {"step", 0.1},
+      {"steps", 2}};
+  return scene.dump();
+}
+
+TEST_CASE("a dense Lagrangian of more than 4096 position and velocity numbers is refused, exit 2, with the limit, "
+          "why and what to write instead; 4096 are taken") {
+  TempDir dir;
+  write_file(dir / "over.json", dense_oscillator_scene(2049));
+  check_bad_scene(dir / "over.json",
+                  "/system/lagrangian: the harmonic-oscillator Lagrangian has a dense Hessian over its 4098 position "
+                  "and velocity numbers, and at most 4096 are taken (the Hessian and the Newton matrices grow as the "
+                  "square: 134 MB for this Hessian alone); write it as a sum of terms (sdk::TermwiseLagrangian) or as "
+                  "a composite system, whose Hessians are sparse");
+  write_file(dir / "limit.json", dense_oscillator_scene(2048));
+  CHECK(run_varia("validate '" + (dir / "limit.json").string() + "'").code == 0);
 }
 
 TEST_CASE("nesting is counted to exactly 64 levels: 64 pass the reader, 65 are refused") {

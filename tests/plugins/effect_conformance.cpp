@@ -1,5 +1,6 @@
-// The effect plugins (core/effect.hpp): exact gradients and sparse Hessians against central
-// differences, for every effect plugin built; and the composite Lagrangian they make
+// The effect plugins (core/effect.hpp): the SDK's effect suite (Taylor tests of the gradient and
+// sparse Hessian, varia/sdk/conformance/effect.hpp) over every effect plugin built, and the
+// force suite over every force plugin; and the composite Lagrangian they make
 // (core/composite.hpp) integrated by the sparse Galerkin construction against an independent
 // reference: the elastic pendulum, whose acceleration is written here by hand and integrated by
 // Runge-Kutta-Fehlberg 7(8).
@@ -13,6 +14,7 @@
 
 #include "../core/fixtures.hpp"
 #include "load_plugin.hpp"
+#include "varia/sdk/conformance/plugin.hpp"
 #include "varia/core/composite.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/mechanics.hpp"
@@ -34,65 +36,17 @@ std::shared_ptr<Effect> make_effect(const std::string& type, const Json& paramet
   return effect;
 }
 
-struct Values {
-  double V = 0.0;
-  VectorXd gradient;
-  Eigen::MatrixXd hessian;  // dense, from the pattern
-};
-
-Values evaluate(Effect& effect, const VectorXd& x) {
-  const int *rows = nullptr, *cols = nullptr;
-  const int entries = effect.hessian_pattern(&rows, &cols);
-  Values values{0.0, VectorXd(x.size()), Eigen::MatrixXd::Zero(x.size(), x.size())};
-  VectorXd hessian(entries);
-  REQUIRE(effect.evaluate(x.data(), &values.V, values.gradient.data(), hessian.data()) == nullptr);
-  for (int e = 0; e < entries; ++e) values.hessian(rows[e], cols[e]) += hessian[e];
-  return values;
-}
-
-// Every effect's gradient and Hessian agree with central differences of V and of the gradient.
-void check_derivatives(Effect& effect) {
-  const int* indices = nullptr;
-  const int k = effect.coordinates(&indices);
-  VectorXd x(k);
-  for (int j = 0; j < k; ++j) x[j] = 0.3 + 0.7 * std::sin(1.7 * indices[j] + 0.4);
-  const Values at = evaluate(effect, x);
-  const double step = 1e-5;
-  for (int j = 0; j < k; ++j) {
-    VectorXd plus = x, minus = x;
-    plus[j] += step;
-    minus[j] -= step;
-    const Values a = evaluate(effect, plus), b = evaluate(effect, minus);
-    CHECK(at.gradient[j] == doctest::Approx((a.V - b.V) / (2 * step)).epsilon(1e-7));
-    const VectorXd column = (a.gradient - b.gradient) / (2 * step);
-    CHECK((at.hessian.col(j) - column).lpNorm<Eigen::Infinity>() <= 1e-6 * (1.0 + column.norm()));
-  }
-}
-
-const std::map<std::string, std::vector<Json>>& cases() {
-  static const std::map<std::string, std::vector<Json>> table{
-      {"gravity", {{{"g", {0.0, -9.81, 0.5}}}}},
-      {"spring",
-       {{{"between", {0, 2}}, {"stiffness", 3.0}, {"rest_length", 0.7}},
-        {{"anchor", {0.1, 0.2, 0.3}}, {"particle", 1}, {"stiffness", 2.0}, {"rest_length", 0.2}},
-        {{"between", {1, 0}}}}},
-      {"central", {{{"particle", 1}, {"mu", 2.0}, {"center", {0.5, -1.0, 0.2}}}, {{"particle", 2}}}}};
-  return table;
-}
-
 }  // namespace
 
-TEST_CASE("every effect plugin: its gradient and sparse Hessian are the exact derivatives of V") {
-  for (const auto& file : varia::test::plugin_files("effect")) {
-    const varia::test::LoadedPlugin plugin(file);
-    const std::string type = plugin.info().type;
-    CAPTURE(type);
-    REQUIRE(cases().count(type) == 1);
-    for (const Json& parameters : cases().at(type)) {
-      CAPTURE(parameters.dump());
-      check_derivatives(*make_effect(type, parameters));
+TEST_CASE("every effect and force plugin passes the SDK's suite of its kind (Taylor tests of its derivatives)") {
+  for (const char* kind : {"effect", "force"})
+    for (const auto& file : varia::test::plugin_files(kind)) {
+      CAPTURE(file);
+      const varia::test::LoadedPlugin plugin(file);
+      std::string checked;
+      varia::test::check_conforms(varia::sdk::conformance::check_plugin(plugin, checked));
+      CHECK(checked.find(std::string(kind) + " suite") != std::string::npos);
     }
-  }
 }
 
 TEST_CASE("effects touch only the coordinates they name, and refuse particles that do not exist") {

@@ -180,8 +180,12 @@ TEST_CASE("the Lagrangian plugins refuse unsupported manifolds and bad parameter
                     "pendulum needs manifold Rn with dim 1, got SO3 with dim 3");
   CHECK_THROWS_WITH(make("kepler", none, rn(1)),
                     "kepler needs manifold Rn with dim 2 to 3, got Rn with dim 1");
-  CHECK_THROWS_WITH(make("harmonic_oscillator", none, rn(10)),
-                    "harmonic-oscillator needs manifold Rn with dim 1 to 9, got Rn with dim 10");
+  CHECK_THROWS_WITH(make("harmonic_oscillator", none, kSO3),
+                    "harmonic-oscillator needs manifold Rn with dim >= 1, got SO3 with dim 3");
+  CHECK_THROWS_WITH(make("morse_chain", none, rn(2)),
+                    "morse-chain needs manifold Rn with dim >= 4, got Rn with dim 2");
+  CHECK_THROWS_WITH(make("morse_chain", none, rn(61)),
+                    "morse-chain needs manifold Rn with an even dim (2 numbers a particle), got dim 61");
   CHECK_THROWS_WITH(make("pendulum", {{"length", 0}}, rn(1)),
                     "parameter 'length' must be a number > 0, got 0");
   CHECK_THROWS_WITH(make("kepler", {{"mu", "one"}}, rn(2)),
@@ -191,6 +195,7 @@ TEST_CASE("the Lagrangian plugins refuse unsupported manifolds and bad parameter
 TEST_CASE(
     "lagrangian harmonic-oscillator: E = m/2|v|^2 + k/2|q|^2; the exact solution "
     "solves m q'' = -k q") {
+  CHECK(make("harmonic_oscillator", Json::object(), rn(40))->position_size() == 40);  // any dim
   const auto oscillator = make("harmonic_oscillator", {{"mass", 2.0}, {"stiffness", 3.0}}, rn(3));
   const VectorXd q0 = vec({1.0, -0.5, 0.25}), v0 = vec({0.3, 0.7, -1.1});
   CHECK(energy(*oscillator, q0, v0) ==

@@ -8,13 +8,13 @@
 // the scene's "terms" and hands them in; no plugin calls another.
 #pragma once
 
-#include <map>
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "varia/core/effect.hpp"
 #include "varia/core/lagrangian.hpp"
+#include "varia/core/sparse_pattern.hpp"
 
 namespace varia {
 
@@ -39,16 +39,13 @@ class CompositeLagrangian : public Lagrangian {
     std::vector<int> slots;
     std::vector<double> x, gradient, hessian;
   };
-  using Slots = std::map<std::pair<int, int>, int>;
-  Term bind(std::shared_ptr<Effect> effect, std::size_t index, Slots& slots);
-  // The slot of entry (row, col) in the pattern, appended when new.
-  int slot(int row, int col, Slots& slots);
+  Term bind(std::shared_ptr<Effect> effect, std::size_t index);
   void add_term(Term& term, const double* q, double* value, double* gradient, double* hessian);
 
   int d_, n_;
   std::vector<double> masses_;  // one per coordinate: m_i repeated d times
   std::vector<Term> terms_;
-  std::vector<int> rows_, cols_;
+  SparsePattern pattern_;
   std::string error_;
 };
 

@@ -1,53 +1,44 @@
 // A Lagrangian written once, templated on its scalar, with exact derivatives by forward-mode
-// automatic differentiation (Eigen's AutoDiffScalar; nested once for the Hessian). The model
-// class derives from AutodiffLagrangian<Model> and defines
+// automatic differentiation (dual.hpp: Eigen's AutoDiffScalar; nested once for the Hessian). The
+// model class derives from AutodiffLagrangian<Model> and defines
 //
 //   template <class T> T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const;
 //
-// Derivative vectors have a fixed capacity, so an evaluation allocates nothing; for the common
+// Any number m + n of positions and velocities. Up to kStackVariables (18) the derivatives are
+// taken in one pass by dual numbers on the stack, so an evaluation allocates nothing; for the common
 // sizes m + n = 2, 4, 6, 12 (Rn of dim 1, 2, 3; SO3) they have a fixed size, so the arithmetic
-// is unrolled and a second-order scalar holds (k+1)^2 doubles instead of 17^2. The same model,
+// is unrolled and a second-order scalar holds (k+1)^2 doubles instead of 19^2. Above it the
+// Hessian is dense all the same, and forward mode runs in chunks of kChunkDirections directions
+// over workspace vectors sized once: k/8 passes of the model for the gradient, one pass per pair
+// of chunks for the Hessian, so a Hessian costs about k^2/64 evaluations of the model at 81-double
+// scalars. A large system whose L is a sum of terms over few numbers each is better written as a
+// TermwiseLagrangian (termwise_lagrangian.hpp): linear cost and a sparse Hessian. The same model,
 // evaluated at dual numbers over second-order jets (kJetDirections derivative directions at a
-// time), gives gradient_jet for every size.
+// time), gives gradient_jet, for up to kStackVariables numbers (the shooting construction's jets
+// hold fewer variables than that).
 #pragma once
 
 #include <Eigen/Core>
-#include <string>
 #include <algorithm>
+#include <stdexcept>
+#include <string>
 #include <type_traits>
-#include <unsupported/Eigen/AutoDiff>
 
 #include "varia/core/lagrangian.hpp"
+#include "varia/sdk/dual.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::sdk {
 
-inline constexpr int kMaxAutodiffVariables = 18;  // m + n of an autodiff Lagrangian (SE(3): 12 + 6)
-// First derivatives at jet inputs (Lagrangian::gradient_jet) are taken kJetDirections numbers of
-// (q, v) at a time, one evaluation per block: a dual number over jets then holds 1 + 4 jets, and
-// a Vec of them (18 x 5 x 1.3 kB) stays within Eigen's stack allocation limit (128 kB).
-inline constexpr int kJetDirections = 4;
-template <class T>
-using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, kMaxAutodiffVariables, 1>;
-using Dual = Eigen::AutoDiffScalar<Vec<double>>;
-using Dual2 = Eigen::AutoDiffScalar<Vec<Dual>>;
-// The fixed-size counterparts for m + n = K (Eigen's AutoDiffScalar takes any derivative vector).
-template <int K>
-using FixedDual = Eigen::AutoDiffScalar<Eigen::Matrix<double, K, 1>>;
-template <int K>
-using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
-// A dual number over jets with K derivative directions.
-template <int K>
-using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, K, 1>>;
-
 template <class Model>
 class AutodiffLagrangian : public Lagrangian {
  public:
-  AutodiffLagrangian(int position_size, int velocity_size) : m_(position_size), n_(velocity_size) {
-    if (m_ + n_ > kMaxAutodiffVariables)
-      throw std::invalid_argument("an autodiff Lagrangian takes at most " +
-                                  std::to_string(kMaxAutodiffVariables) +
-                                  " position and velocity numbers together");
+  AutodiffLagrangian(int position_size, int velocity_size)
+      : m_(position_size), n_(velocity_size), q_(position_size), v_(velocity_size) {
+    if (m_ + n_ > kStackVariables) {
+      chunk_q_.resize(m_), chunk_v_.resize(n_);
+      chunk2_q_.resize(m_), chunk2_v_.resize(n_);
+    }
   }
   int position_size() const noexcept final { return m_; }
   int velocity_size() const noexcept final { return n_; }
@@ -55,7 +46,15 @@ class AutodiffLagrangian : public Lagrangian {
   Status evaluate(const double* q, const double* v, double* value, double* gradient,
                   double* hessian) noexcept final {
     return guarded(error_, [&] {
-      if (hessian != nullptr)
+      if (gradient == nullptr && hessian == nullptr) {
+        if (value == nullptr) return;
+        q_ = Eigen::Map<const Vec<double>>(q, m_);
+        v_ = Eigen::Map<const Vec<double>>(v, n_);
+        *value = model().lagrangian(q_, v_);
+      } else if (m_ + n_ > kStackVariables) {
+        if (hessian != nullptr) chunked_second_order(q, v, value, gradient, hessian);
+        else chunked_first_order(q, v, value, gradient);
+      } else if (hessian != nullptr)
         dispatch([&](auto, auto second, auto) {
           second_order<typename decltype(second)::type>(q, v, value, gradient, hessian);
         });
@@ -67,15 +66,15 @@ class AutodiffLagrangian : public Lagrangian {
         dispatch([&](auto first, auto, auto m) {
           first_order<typename decltype(first)::type, decltype(m)::value, false>(q, v, value, gradient);
         });
-      else if (value != nullptr)
-        *value = model().lagrangian(Vec<double>(Eigen::Map<const Vec<double>>(q, m_)),
-                                    Vec<double>(Eigen::Map<const Vec<double>>(v, n_)));
     });
   }
 
   bool evaluates_at_jets() const noexcept final { return true; }
   Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final {
     return guarded(error_, [&] {
+      if (m_ + n_ > kStackVariables)
+        throw std::length_error("an autodiff Lagrangian evaluates at jets with at most " +
+                                 std::to_string(kStackVariables) + " position and velocity numbers together");
       if (m_ + n_ <= 2) return jet_first_order<2>(q, v, 0, value, gradient);
       for (int first = 0; first < m_ + n_; first += kJetDirections)
         jet_first_order<kJetDirections>(q, v, first, first == 0 ? value : nullptr, gradient);
@@ -90,6 +89,8 @@ class AutodiffLagrangian : public Lagrangian {
   // Number k of (q, v), q having m numbers.
   template <class T>
   static const T& at(const T* q, const T* v, int m, int k) { return k < m ? q[k] : v[k - m]; }
+  template <class T>
+  T& input(Vec<T>& q, Vec<T>& v, int k) const { return k < m_ ? q(k) : v(k - m_); }
 
   // Calls f with tags (std::type_identity) of the first- and second-order scalar types for
   // k = m + n, and m as a compile-time constant (Shape): fixed-size types where k is one of the
@@ -159,46 +160,65 @@ class AutodiffLagrangian : public Lagrangian {
     using JD = JetDual<K>;
     const int k = m_ + n_, last = std::min(first + K, k);
     Vec<JD> qd(m_), vd(n_);
-    for (int i = 0; i < k; ++i) {
-      JD& z = i < m_ ? qd(i) : vd(i - m_);
-      z.value() = at(q, v, m_, i);
-      z.derivatives().setConstant(Jet2(0.0));
-      if (i >= first && i < last) z.derivatives()(i - first) = Jet2(1.0);
-    }
+    for (int i = 0; i < k; ++i) seed(input(qd, vd, i), at(q, v, m_, i), K, i - first);
     const JD r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value();
-    for (int i = first; i < last; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i - first) : Jet2();
+    for (int i = first; i < last; ++i) gradient[i] = derivative(r, i - first);
   }
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).
   template <class D2>
   void second_order(const double* q, const double* v, double* value, double* gradient,
                     double* hessian) const {
-    using D = typename D2::Scalar;
-    using Inner = typename D::DerType;
     const int k = m_ + n_;
     Vec<D2> qd(m_), vd(n_);
-    for (int i = 0; i < k; ++i) {
-      D2 z;
-      z.value() = D(at(q, v, m_, i), k, i);
-      z.derivatives().resize(k);
-      for (int j = 0; j < k; ++j) z.derivatives()(j) = D(i == j ? 1.0 : 0.0, Inner::Zero(k));
-      (i < m_ ? qd(i) : vd(i - m_)) = z;
-    }
+    for (int i = 0; i < k; ++i) seed(input(qd, vd, i), at(q, v, m_, i), k, i, k, i);
     const D2 r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value().value();
-    const bool has_first = r.value().derivatives().size() == k;
-    const bool has_second = r.derivatives().size() == k;
     for (int i = 0; i < k; ++i) {
-      if (gradient != nullptr) gradient[i] = has_first ? r.value().derivatives()(i) : 0.0;
-      for (int j = 0; j < k; ++j) {
-        const bool has = has_second && r.derivatives()(j).derivatives().size() == k;
-        hessian[j * k + i] = has ? r.derivatives()(j).derivatives()(i) : 0.0;
+      if (gradient != nullptr) gradient[i] = derivative(r.value(), i);
+      for (int j = 0; j < k; ++j) hessian[j * k + i] = second_derivative(r, j, i);
+    }
+  }
+
+  // Above kStackVariables: L and the gradient by forward mode, kChunkDirections directions of
+  // (q, v) per pass of the model.
+  void chunked_first_order(const double* q, const double* v, double* value, double* gradient) {
+    const int k = m_ + n_;
+    for (int first = 0; first < k; first += kChunkDirections) {
+      const int size = std::min(kChunkDirections, k - first);
+      for (int i = 0; i < k; ++i) seed(input(chunk_q_, chunk_v_, i), at(q, v, m_, i), size, i - first);
+      const ChunkDual r = model().lagrangian(chunk_q_, chunk_v_);
+      if (value != nullptr && first == 0) *value = r.value();
+      for (int i = 0; i < size; ++i) gradient[first + i] = derivative(r, i);
+    }
+  }
+  // And the Hessian: forward over forward, one pass per pair of chunks (a, b) with b >= a, whose
+  // block of second derivatives gives H(a.., b..) and, by symmetry, H(b.., a..).
+  void chunked_second_order(const double* q, const double* v, double* value, double* gradient,
+                            double* hessian) {
+    const int k = m_ + n_;
+    for (int a = 0; a < k; a += kChunkDirections) {
+      const int inner = std::min(kChunkDirections, k - a);
+      for (int b = a; b < k; b += kChunkDirections) {
+        const int outer = std::min(kChunkDirections, k - b);
+        for (int i = 0; i < k; ++i) seed(input(chunk2_q_, chunk2_v_, i), at(q, v, m_, i), inner, i - a, outer, i - b);
+        const ChunkDual2 r = model().lagrangian(chunk2_q_, chunk2_v_);
+        if (value != nullptr && a == 0 && b == 0) *value = r.value().value();
+        if (gradient != nullptr && a == b)
+          for (int i = 0; i < inner; ++i) gradient[a + i] = derivative(r.value(), i);
+        for (int j = 0; j < outer; ++j)
+          for (int i = 0; i < inner; ++i)
+            hessian[(a + i) * k + b + j] = hessian[(b + j) * k + a + i] = second_derivative(r, j, i);
       }
     }
   }
 
   int m_, n_;
+  // Workspace, sized once: the value's inputs, and above kStackVariables the chunks' dual inputs.
+  Vec<double> q_, v_;
+  Vec<ChunkDual> chunk_q_, chunk_v_;
+  Vec<ChunkDual2> chunk2_q_, chunk2_v_;
 };
 
 }  // namespace varia::sdk

@@ -13,6 +13,7 @@
 
 #include "varia/core/lagrangian.hpp"
 #include "varia/sdk/conformance/failures.hpp"
+#include "varia/sdk/conformance/taylor.hpp"
 
 namespace varia::sdk::conformance {
 
@@ -49,14 +50,6 @@ inline VectorXd gradient(Lagrangian& lagrangian, const VectorXd& q, const Vector
   VectorXd g(lagrangian.position_size() + lagrangian.velocity_size());
   check(lagrangian, lagrangian.evaluate(q.data(), v.data(), nullptr, g.data(), nullptr), "evaluate");
   return g;
-}
-
-// Components of magnitude in [0.5, 1.5] with random signs: away from the origin (kepler).
-inline VectorXd random_point(int size, std::mt19937& engine) {
-  std::uniform_real_distribution<double> magnitude(0.5, 1.5);
-  VectorXd x(size);
-  for (int i = 0; i < size; ++i) x(i) = (engine() % 2 ? 1 : -1) * magnitude(engine);
-  return x;
 }
 
 // z = (q, v) with component i moved by `step`.

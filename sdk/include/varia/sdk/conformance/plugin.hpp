@@ -1,8 +1,9 @@
 // The conformance suite of one plugin file, whatever its kind: its metadata (the parameter
 // schema and properties are JSON objects; the schema's defaults are the constructor's defaults),
 // then the suite of its kind over the objects it makes: every quadrature of its integer
-// parameters' sweep, every Lagrangian in each context it accepts with default parameters.
-// Kinds without a suite yet have their metadata checked only.
+// parameters' sweep, every Lagrangian in each context it accepts with default parameters, every
+// effect and force made from each of its schema's "examples" (or from {} without examples) in
+// each system it accepts. Kinds without a suite yet have their metadata checked only.
 #pragma once
 
 #include <memory>
@@ -11,7 +12,9 @@
 #include <string>
 #include <vector>
 
+#include "varia/sdk/conformance/effect.hpp"
 #include "varia/sdk/conformance/failures.hpp"
+#include "varia/sdk/conformance/force.hpp"
 #include "varia/sdk/conformance/lagrangian.hpp"
 #include "varia/sdk/conformance/loader.hpp"
 #include "varia/sdk/conformance/quadrature.hpp"
@@ -69,6 +72,60 @@ inline void check_lagrangian_plugin(const LoadedPlugin& plugin, Failures& failur
   failures.expect(accepted > 0, "no context accepted with default parameters (Rn of dim 1 to 8, SO3)");
 }
 
+// The parameter objects an effect or force is made with: the schema's "examples" (draft-07), or
+// {} when it has none.
+inline std::vector<nlohmann::json> schema_examples(const nlohmann::json& schema) {
+  const nlohmann::json examples = schema.value("examples", nlohmann::json::array());
+  if (!examples.is_array() || examples.empty()) return {nlohmann::json::object()};
+  return examples.get<std::vector<nlohmann::json>>();
+}
+
+// The systems an effect is bound to: kEffectParticles particles of distinct masses in 1, 2 and 3
+// dimensions. An example that its effect refuses in a system (a vector of another size, a
+// particle that does not exist) is skipped there; at least one must be checked.
+inline constexpr int kEffectParticles = 4;
+inline void check_effect_plugin(const LoadedPlugin& plugin, Failures& failures) {
+  std::mt19937 engine(20240611);
+  const double masses[kEffectParticles] = {1.0, 1.5, 2.0, 2.5};
+  int checked = 0;
+  for (const auto& parameters : schema_examples(plugin.parameter_schema()))
+    for (int d = 1; d <= 3; ++d) {
+      const int n = d * kEffectParticles;
+      std::shared_ptr<Effect> effect;
+      try {
+        effect = plugin.create<Effect>(parameters, {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
+      } catch (const std::runtime_error&) {
+        continue;
+      }
+      if (effect->bind(d, kEffectParticles, masses) != nullptr) continue;
+      ++checked;
+      const Failures found = check_effect(*effect, n, engine);
+      for (const auto& failure : found.list())
+        failures.expect(false, parameters.dump(), " in space_dim ", d, ": ", failure);
+    }
+  failures.expect(checked > 0, "no example parameters (the schema's \"examples\", else {}) made an effect that binds to ",
+                  kEffectParticles, " particles in space_dim 1 to 3");
+}
+
+// A force in each context Rn of dim 1 to 4 that it accepts, for each example.
+inline void check_force_plugin(const LoadedPlugin& plugin, Failures& failures) {
+  std::mt19937 engine(20240611);
+  int checked = 0;
+  for (const auto& parameters : schema_examples(plugin.parameter_schema()))
+    for (int n = 1; n <= 4; ++n) {
+      std::shared_ptr<Force> force;
+      try {
+        force = plugin.create<Force>(parameters, {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
+      } catch (const std::runtime_error&) {
+        continue;
+      }
+      ++checked;
+      const Failures found = check_force(*force, engine);
+      for (const auto& failure : found.list()) failures.expect(false, parameters.dump(), " on Rn of dim ", n, ": ", failure);
+    }
+  failures.expect(checked > 0, "no example parameters (the schema's \"examples\", else {}) made a force on Rn of dim 1 to 4");
+}
+
 inline void check_quadrature_plugin(const LoadedPlugin& plugin, Failures& failures) {
   for (const auto& parameters : parameter_sweep(plugin.parameter_schema())) {
     const Failures found = check_quadrature(*plugin.create<Quadrature>(parameters));  // kept alive for list()
@@ -90,6 +147,12 @@ inline Failures check_plugin(const LoadedPlugin& plugin, std::string& checked) {
     } else if (kind == "lagrangian") {
       check_lagrangian_plugin(plugin, failures);
       checked += ", lagrangian suite (derivatives, Hessian symmetry, mass matrix, symmetry, defaults)";
+    } else if (kind == "effect") {
+      check_effect_plugin(plugin, failures);
+      checked += ", effect suite (coordinates, Hessian pattern and symmetry, gradient and Hessian by Taylor tests)";
+    } else if (kind == "force") {
+      check_force_plugin(plugin, failures);
+      checked += ", force suite (Jacobian pattern, Jacobian by Taylor tests)";
     }
   } catch (const std::exception& e) {
     failures.expect(false, "failed: ", e.what());

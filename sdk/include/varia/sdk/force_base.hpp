@@ -1,5 +1,7 @@
-// What the force plugins share (core/include/varia/core/force.hpp): the system's sizes from the
-// context, and the boundary rule (exceptions become Status messages).
+// A force (core/include/varia/core/force.hpp), for force plugins: the system's sizes from the
+// context, the Jacobian's pattern as the plugin declares its entries, and the boundary rule
+// (exceptions become Status messages). docs/writing-effects.md has the walk-through, and
+// varia-conformance checks the Jacobian (sdk/conformance/force.hpp).
 #pragma once
 
 #include <string>
@@ -8,11 +10,11 @@
 #include "varia/core/force.hpp"
 #include "varia/sdk/plugin.hpp"
 
-namespace varia::plugins {
+namespace varia::sdk {
 
 class ForceBase : public Force {
  public:
-  explicit ForceBase(const sdk::Context& context) : m_(context.point_size), n_(context.dim) {}
+  explicit ForceBase(const Context& context) : m_(context.point_size), n_(context.dim) {}
   int position_size() const noexcept final { return m_; }
   int velocity_size() const noexcept final { return n_; }
   int jacobian_pattern(const int** rows, const int** cols) const noexcept final {
@@ -22,7 +24,7 @@ class ForceBase : public Force {
   }
   Status evaluate(double t, const double* q, const double* v, double* force,
                   double* jacobian) noexcept final {
-    return sdk::guarded(error_, [&] { apply(t, q, v, force, jacobian); });
+    return guarded(error_, [&] { apply(t, q, v, force, jacobian); });
   }
 
  protected:
@@ -40,4 +42,4 @@ class ForceBase : public Force {
   std::string error_;
 };
 
-}  // namespace varia::plugins
+}  // namespace varia::sdk

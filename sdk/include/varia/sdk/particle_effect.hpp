@@ -1,6 +1,9 @@
-// What the effect plugins share (core/include/varia/core/effect.hpp): the bound system, the
-// coordinates of the particles an effect names, a dense Hessian pattern over them, and the
-// boundary rule (exceptions become Status messages).
+// An effect over particles (core/include/varia/core/effect.hpp), for effect plugins: the bound
+// system (space_dim d, the particles and their masses), the coordinates of the particles an effect
+// names, a dense Hessian pattern over them, and the boundary rule (exceptions become Status
+// messages). A plugin derives from ParticleEffect, chooses its particles in attach() and writes
+// V, dV/dx and the Hessian in potential(); docs/writing-effects.md is the walk-through, and
+// varia-conformance checks the derivatives (sdk/conformance/effect.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -12,7 +15,7 @@
 #include "varia/core/effect.hpp"
 #include "varia/sdk/plugin.hpp"
 
-namespace varia::plugins {
+namespace varia::sdk {
 
 // A parameter value that names a particle: a non-negative integer (`name`: the parameter's name).
 inline int particle_index(const nlohmann::json& value, const char* name) {
@@ -36,7 +39,7 @@ inline std::vector<double> vector_parameter(const nlohmann::json& parameters, co
 class ParticleEffect : public Effect {
  public:
   Status bind(int space_dim, int particles, const double* masses) noexcept final {
-    return sdk::guarded(error_, [&] {
+    return guarded(error_, [&] {
       d_ = space_dim;
       particles_ = particles;
       masses_.assign(masses, masses + particles);
@@ -53,7 +56,7 @@ class ParticleEffect : public Effect {
     return static_cast<int>(rows_.size());
   }
   Status evaluate(const double* x, double* value, double* gradient, double* hessian) noexcept final {
-    return sdk::guarded(error_, [&] { potential(x, value, gradient, hessian); });
+    return guarded(error_, [&] { potential(x, value, gradient, hessian); });
   }
 
  protected:
@@ -93,4 +96,4 @@ class ParticleEffect : public Effect {
   std::string error_;
 };
 
-}  // namespace varia::plugins
+}  // namespace varia::sdk

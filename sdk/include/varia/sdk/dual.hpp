@@ -1,0 +1,98 @@
+// Dual numbers for forward-mode automatic differentiation (Eigen's AutoDiffScalar; nested once for
+// second derivatives), and the seeding and reading of them that the SDK's Lagrangian adapters share
+// (autodiff_lagrangian.hpp, termwise_lagrangian.hpp).
+//
+// A model is written once, templated on its scalar T, over vectors Vec<T>. Small systems (at most
+// kStackVariables numbers) are differentiated in one pass by dual numbers whose derivative vectors
+// have a fixed size or a fixed capacity, so that a Vec of them lives on the stack and an evaluation
+// allocates nothing. Larger systems are differentiated in chunks of kChunkDirections directions at a
+// time (ChunkDual, ChunkDual2); a Vec of those, like a Vec of doubles, has no capacity bound, and
+// the adapter that evaluates them keeps it as a workspace sized once.
+#pragma once
+
+#include <Eigen/Core>
+#include <type_traits>
+#include <unsupported/Eigen/AutoDiff>
+
+#include "varia/core/jet.hpp"
+
+namespace varia::sdk {
+
+// Up to this many numbers m + n, a dense Lagrangian is differentiated in one pass (SE(3): 12 + 6).
+inline constexpr int kStackVariables = 18;
+// Above it, forward mode takes this many derivative directions per pass (a gradient: k / 8 passes
+// of the model; a Hessian: one pass per pair of chunks).
+inline constexpr int kChunkDirections = 8;
+// First derivatives at jet inputs (Lagrangian::gradient_jet) are taken kJetDirections numbers of
+// (q, v) at a time, one evaluation per block: a dual number over jets then holds 1 + 4 jets, and
+// a Vec of them (18 x 5 x 1.3 kB) stays within Eigen's stack allocation limit (128 kB).
+inline constexpr int kJetDirections = 4;
+
+// A vector of at most `Capacity` numbers, stored in place.
+template <class T, int Capacity>
+using Bounded = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, Capacity, 1>;
+
+using Dual = Eigen::AutoDiffScalar<Bounded<double, kStackVariables>>;
+using Dual2 = Eigen::AutoDiffScalar<Bounded<Dual, kStackVariables>>;
+// The fixed-size counterparts for K variables (unrolled arithmetic; a second-order scalar holds
+// (K+1)^2 doubles instead of 19^2).
+template <int K>
+using FixedDual = Eigen::AutoDiffScalar<Eigen::Matrix<double, K, 1>>;
+template <int K>
+using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
+// A dual number over jets with K derivative directions.
+template <int K>
+using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, K, 1>>;
+// The large systems' dual numbers: kChunkDirections directions (fewer in the last chunk).
+using ChunkDual = Eigen::AutoDiffScalar<Bounded<double, kChunkDirections>>;
+using ChunkDual2 = Eigen::AutoDiffScalar<Bounded<ChunkDual, kChunkDirections>>;
+static_assert(kChunkDirections != kStackVariables, "the chunk duals must be types of their own (see Vec)");
+
+// Whether a Vec of T has the stack capacity kStackVariables: every scalar but the value type and
+// the large systems' chunk duals, whose vectors hold any number of inputs.
+template <class T>
+struct OnStack : std::true_type {};
+template <>
+struct OnStack<double> : std::false_type {};
+template <>
+struct OnStack<ChunkDual> : std::false_type {};
+template <>
+struct OnStack<ChunkDual2> : std::false_type {};
+
+// The vectors q and v a model's lagrangian<T>(q, v) takes.
+template <class T>
+using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, OnStack<T>::value ? kStackVariables : Eigen::Dynamic, 1>;
+
+// The first-order variable x along direction `direction` of `size` (none when direction is
+// outside [0, size)). X is double, or Jet2 for a dual number over jets.
+template <class D, class X>
+void seed(D& z, const X& x, int size, int direction) {
+  z.value() = x;
+  z.derivatives().setZero(size);
+  if (direction >= 0 && direction < size) z.derivatives()(direction) = 1.0;
+}
+
+// The second-order variable x: first derivatives along `inner` of `inner_size` directions, the
+// outer derivatives along `outer` of `outer_size` (forward over forward: the outer derivatives'
+// own derivatives are the second derivatives).
+template <class D2>
+void seed(D2& z, double x, int inner_size, int inner, int outer_size, int outer) {
+  seed(z.value(), x, inner_size, inner);
+  z.derivatives().resize(outer_size);
+  for (int j = 0; j < outer_size; ++j) seed(z.derivatives()(j), j == outer ? 1.0 : 0.0, inner_size, -1);
+}
+
+// Derivative i of a result (zero when the result does not depend on the inputs: an expression of
+// constants leaves a dynamic derivative vector empty).
+template <class D>
+typename D::Scalar derivative(const D& r, int i) {
+  if (r.derivatives().size() > i) return r.derivatives()(i);
+  return typename D::Scalar(0.0);
+}
+// The second derivative of a second-order result along outer direction j and inner direction i.
+template <class D2>
+double second_derivative(const D2& r, int j, int i) {
+  return r.derivatives().size() > j ? derivative(r.derivatives()(j), i) : 0.0;
+}
+
+}  // namespace varia::sdk

@@ -1,0 +1,120 @@
+// sdk::AutodiffLagrangian at every size: the stack path (m + n <= 18) and the chunked path above
+// it give L, the gradient and the Hessian of the hand-written formulas of the planar Morse chain
+// (morse_chain.hpp), through every evaluate() path, and its shooting path at jets is refused above
+// the stack size with a message.
+#include <doctest/doctest.h>
+
+#include <Eigen/Core>
+#include <chrono>
+
+#include "morse_chain.hpp"
+
+namespace {
+
+using Eigen::MatrixXd;
+using Eigen::VectorXd;
+using varia::testing::DenseMorseChain;
+using varia::testing::MorseChainFormula;
+using varia::testing::MorseChainParameters;
+
+struct Evaluation {
+  double value = 0.0;
+  VectorXd gradient;
+  MatrixXd hessian;
+};
+
+Evaluation evaluate(varia::Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v) {
+  const int k = lagrangian.position_size() + lagrangian.velocity_size();
+  Evaluation e{0.0, VectorXd(k), MatrixXd(k, k)};
+  REQUIRE(lagrangian.evaluate(q.data(), v.data(), &e.value, e.gradient.data(), e.hessian.data()) == nullptr);
+  return e;
+}
+
+// The largest deviations of the model's L, gradient and Hessian from the formula's, relative to
+// the size of each (of L: 1 + |L|, as L is a difference of energies of order 1).
+struct Deviations {
+  double value, gradient, hessian;
+};
+Deviations deviations(varia::Lagrangian& lagrangian, const MorseChainFormula& formula, const VectorXd& q,
+                      const VectorXd& v) {
+  const Evaluation e = evaluate(lagrangian, q, v);
+  const VectorXd g = formula.gradient(q, v);
+  const MatrixXd H = formula.hessian(q);
+  return {std::abs(e.value - formula.value(q, v)) / (1 + std::abs(formula.value(q, v))),
+          (e.gradient - g).lpNorm<Eigen::Infinity>() / g.lpNorm<Eigen::Infinity>(),
+          (e.hessian - H).lpNorm<Eigen::Infinity>() / H.lpNorm<Eigen::Infinity>()};
+}
+
+}  // namespace
+
+TEST_CASE("a dense autodiff Lagrangian of any size gives the exact L, gradient and Hessian: the planar Morse "
+          "chain of 3 particles (12 numbers, fixed size), 4 (16, stack), 5 (20, chunks) and 30 (120, chunks)") {
+  for (int particles : {3, 4, 5, 30}) {
+    CAPTURE(particles);
+    MorseChainParameters p;
+    p.particles = particles;
+    p.depth = 1.7;
+    p.range = 1.3;
+    DenseMorseChain model(p);
+    VectorXd q, v;
+    varia::testing::morse_chain_state(p, 1, q, v);
+    const Deviations d = deviations(model, MorseChainFormula{p}, q, v);
+    MESSAGE(particles << " particles: relative deviations L " << d.value << ", gradient " << d.gradient
+                      << ", Hessian " << d.hessian);
+    CHECK(d.value <= 1e-15);
+    CHECK(d.gradient <= 1e-14);
+    CHECK(d.hessian <= 1e-14);
+  }
+}
+
+TEST_CASE("the formula check sees a wrong derivative: a chain of another range differs by far more than the "
+          "tolerance") {
+  MorseChainParameters p;
+  DenseMorseChain model(p);
+  MorseChainParameters other = p;
+  other.range *= 1.001;
+  VectorXd q, v;
+  varia::testing::morse_chain_state(p, 1, q, v);
+  const Deviations d = deviations(model, MorseChainFormula{other}, q, v);
+  CHECK(d.gradient > 1e-4);
+  CHECK(d.hessian > 1e-4);
+}
+
+TEST_CASE("every evaluate() path of the chunked dense adapter gives the same numbers") {
+  MorseChainParameters p;
+  p.particles = 13;  // 52 numbers: 6 full chunks and one of 4
+  DenseMorseChain model(p);
+  VectorXd q, v;
+  varia::testing::morse_chain_state(p, 2, q, v);
+  const Evaluation all = evaluate(model, q, v);
+  const int k = 4 * p.particles;
+  double value = 0.0;
+  VectorXd gradient(k), gradient_alone(k);
+  MatrixXd hessian_alone(k, k);
+  // L alone is taken in doubles, with the gradient at first-order duals, with the Hessian at
+  // second-order ones: the same operations on the values, rounded alike up to the last bit.
+  REQUIRE(model.evaluate(q.data(), v.data(), &value, nullptr, nullptr) == nullptr);
+  CHECK(value == doctest::Approx(all.value).epsilon(1e-15));
+  REQUIRE(model.evaluate(q.data(), v.data(), &value, gradient.data(), nullptr) == nullptr);
+  CHECK(value == doctest::Approx(all.value).epsilon(1e-15));
+  CHECK((gradient - all.gradient).lpNorm<Eigen::Infinity>() <= 1e-15 * all.gradient.lpNorm<Eigen::Infinity>());
+  REQUIRE(model.evaluate(q.data(), v.data(), nullptr, gradient_alone.data(), nullptr) == nullptr);
+  CHECK(gradient_alone == gradient);
+  REQUIRE(model.evaluate(q.data(), v.data(), nullptr, nullptr, hessian_alone.data()) == nullptr);
+  CHECK(hessian_alone == all.hessian);
+  CHECK(all.hessian == all.hessian.transpose());
+}
+
+TEST_CASE("above the stack size a dense autodiff Lagrangian refuses jet inputs with a message, not a crash") {
+  MorseChainParameters p;
+  p.particles = 5;
+  DenseMorseChain model(p);
+  std::vector<varia::Jet2> q(10, varia::Jet2(1.0)), v(10, varia::Jet2(0.0)), gradient(20);
+  const varia::Status status = model.gradient_jet(q.data(), v.data(), nullptr, gradient.data());
+  REQUIRE(status != nullptr);
+  CHECK(std::string(status) == "an autodiff Lagrangian evaluates at jets with at most 18 position and velocity "
+                               "numbers together");
+  p.particles = 4;
+  DenseMorseChain small(p);
+  CHECK(small.gradient_jet(q.data(), v.data(), nullptr, gradient.data()) == nullptr);
+}

@@ -1,0 +1,98 @@
+// varia-conformance (sdk/tools/varia_conformance.cpp) on effect and force plugins: every bundled
+// effect and force conforms; an effect whose gradient is 1.5 times V's derivative
+// (tests/fault_plugins/wrong_effect_gradient.cpp) is refused, exit 1, with the Taylor test's
+// slope; and the suite, called as a function, refuses a force with a wrong Jacobian entry.
+#include <doctest/doctest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <string>
+
+#include "varia/sdk/conformance/force.hpp"
+#include "varia/sdk/force_base.hpp"
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Outcome {
+  int code;
+  std::string out;
+};
+
+Outcome conformance(const fs::path& file) {
+  const std::string command = "'" + (fs::path(VARIA_BUILD_DIR) / "bin" / "varia-conformance").string() + "' '" +
+                              file.string() + "' 2>&1";
+  FILE* pipe = ::popen(command.c_str(), "r");
+  REQUIRE(pipe != nullptr);
+  std::string out;
+  char buffer[4096];
+  for (std::size_t n; (n = std::fread(buffer, 1, sizeof buffer, pipe)) > 0;) out.append(buffer, n);
+  const int status = ::pclose(pipe);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, out};
+}
+
+fs::path bundled(const std::string& name) { return fs::path(VARIA_BUILD_DIR) / "lib" / "varia" / "plugins" / name; }
+
+// f_i = -c v_i + k q_i^2 on Rn (c = 0.3, k = 0.7): its Jacobian entries df_i/dq_i = 2 k q_i,
+// df_i/dv_i = -c; `wrong` reports the first df/dq entry twice too large.
+class QuadraticForce final : public varia::sdk::ForceBase {
+ public:
+  QuadraticForce(int n, bool wrong) : ForceBase({"Rn", n, n}), wrong_(wrong) {
+    for (int i = 0; i < n; ++i) add_entry(i, i);
+    for (int i = 0; i < n; ++i) add_entry(i, n + i);
+  }
+  void apply(double, const double* q, const double* v, double* force, double* jacobian) const override {
+    for (int i = 0; i < n_; ++i) force[i] = -0.3 * v[i] + 0.7 * q[i] * q[i];
+    if (jacobian == nullptr) return;
+    for (int i = 0; i < n_; ++i) jacobian[i] = (wrong_ && i == 0 ? 2.8 : 1.4) * q[i];
+    for (int i = 0; i < n_; ++i) jacobian[n_ + i] = -0.3;
+  }
+
+ private:
+  bool wrong_;
+};
+
+}  // namespace
+
+TEST_CASE("varia-conformance: every bundled effect and force plugin conforms, by the Taylor tests of its "
+          "derivatives") {
+  for (const char* name : {"effect_gravity.so", "effect_spring.so", "effect_central.so", "effect_gravitation.so",
+                           "force_damping.so", "force_periodic_force.so"}) {
+    const Outcome outcome = conformance(bundled(name));
+    CAPTURE(outcome.out);
+    CHECK(outcome.code == 0);
+    CHECK(outcome.out.find("conforms") != std::string::npos);
+    CHECK(outcome.out.find("Taylor tests") != std::string::npos);
+  }
+}
+
+// The slope the first line of `claim` reports ("... falls as eps^SLOPE (expected eps^2)").
+double reported_slope(const std::string& out, const std::string& claim) {
+  const std::string lead = claim + ": the first-order model's error falls as eps^";
+  const auto at = out.find(lead);
+  REQUIRE(at != std::string::npos);
+  return std::stod(out.substr(at + lead.size()));
+}
+
+TEST_CASE("varia-conformance refuses an effect whose gradient is 1.5 times V's derivative, exit 1, naming the "
+          "gradient and the error's slope eps^1") {
+  const Outcome outcome = conformance(fs::path(VARIA_FAULT_PLUGIN_DIR) / "fault_wrong_effect_gradient.so");
+  CAPTURE(outcome.out);
+  CHECK(outcome.code == 1);
+  CHECK(outcome.out.find("effect 'wrong-gradient' does not conform") != std::string::npos);
+  CHECK(reported_slope(outcome.out, "the gradient is not V's derivative") == doctest::Approx(1.0).epsilon(0.05));
+  // Its Hessian, the identity, is not the derivative of the gradient it reports (1.5 I) either.
+  CHECK(reported_slope(outcome.out, "the Hessian is not the gradient's derivative") ==
+        doctest::Approx(1.0).epsilon(0.05));
+}
+
+TEST_CASE("the force suite refuses a force with one wrong Jacobian entry, and accepts the same force without it") {
+  std::mt19937 engine(7);
+  QuadraticForce right(3, false), wrong(3, true);
+  CHECK(varia::sdk::conformance::check_force(right, engine).empty());
+  const auto failures = varia::sdk::conformance::check_force(wrong, engine);
+  REQUIRE(failures.list().size() >= 1);
+  CHECK(reported_slope(failures.list()[0], "the Jacobian is not the force's derivative in (q, v)") ==
+        doctest::Approx(1.0).epsilon(0.05));
+}
