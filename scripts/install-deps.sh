@@ -5,7 +5,7 @@ set -euo pipefail
 packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libboost-dev nlohmann-json3-dev libfmt-dev doctest-dev libcli11-dev
-  libvalijson-dev gnuplot-nox
+  libvalijson-dev gnuplot-nox libhdf5-dev
   clang libclang-rt-14-dev  # the scene fuzzer (ctest -L fuzz): libFuzzer
 )
 missing=()

@@ -143,8 +143,10 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
                          "printed at the end unless --quiet.",
                          "Example:\n  varia run scenes/default.json --out traj.csv --summary run.json");
   add_scene(run, o.scene);
-  run->add_option("--out", o.run_out, "write the trajectory CSV here (t, q0.., p0.., observables)")
-      ->type_name("FILE.csv");
+  run->add_option("--out", o.run_out,
+                  "write the trajectory here: CSV (t, q0.., p0.., observables), or HDF5 for a name ending in .h5 "
+                  "(datasets t, q, p and one per observable; the scene as the root's attribute 'scene')")
+      ->type_name("FILE.csv|FILE.h5");
   run->add_option("--summary", o.run_summary, "write the run record JSON here")->type_name("FILE.json");
   run->add_option("--plot", o.run_plot, "draw q(t) and the energy error (or p(t)) into this SVG (gnuplot)")
       ->type_name("FILE.svg");

@@ -11,6 +11,7 @@
 
 #include "interrupt.hpp"
 #include "observer.hpp"
+#include "hdf5_output.hpp"
 #include "output.hpp"
 #include "plot.hpp"
 #include "registry.hpp"
@@ -144,7 +145,10 @@ class Stepper {
         a_(a),
         observer_(scene.observe, *a.manifold, *a.lagrangian, a.v0, scene.solver),
         trajectory_(*a.map, a.q0, a.p0, a.t0, scene.step) {
-    if (options.out) csv_ = std::make_unique<CsvWriter>(*options.out);
+    if (options.out && options.out->extension() == ".h5")
+      h5_ = std::make_unique<Hdf5Writer>(*options.out, scene.text);
+    else if (options.out)
+      csv_ = std::make_unique<CsvWriter>(*options.out);
     if (options.plot) plot_ = std::make_unique<PlotRecorder>(scene.observe.energy);
   }
 
@@ -169,6 +173,7 @@ class Stepper {
     }
     outcome_.wall_seconds = std::chrono::duration<double>(Clock::now() - start).count();
     if (csv_) csv_->close();
+    if (h5_) h5_->close();
     return failure;
   }
 
@@ -179,6 +184,7 @@ class Stepper {
  private:
   void start_output() {
     if (csv_) csv_->header(csv_columns(a_.map->point_size(), a_.map->dim(), observer_));
+    if (h5_) h5_->header(a_.map->point_size(), a_.map->dim(), observer_.columns());
     observe_and_write();
   }
 
@@ -204,6 +210,8 @@ class Stepper {
     if (csv_ && due)
       csv_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()),
                 values);
+    if (h5_ && due)
+      h5_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()), values);
     if (plot_ && due) plot_->record(trajectory_.t(), q, p, values);
   }
 
@@ -213,6 +221,7 @@ class Stepper {
   Trajectory trajectory_;
   Outcome outcome_;
   std::unique_ptr<CsvWriter> csv_;
+  std::unique_ptr<Hdf5Writer> h5_;
   std::unique_ptr<PlotRecorder> plot_;
 };
 

@@ -97,6 +97,7 @@ std::vector<const PluginSpec*> Scene::plugins() const {
 Scene parse_scene(const json& document) {
   scene_validator().validate(document, "");
   Scene scene;
+  scene.text = document.dump();
   const json& system = document["system"];
   scene.manifold = plugin_spec(system["manifold"], "/system/manifold", "manifold");
   scene.lagrangian = plugin_spec(system["lagrangian"], "/system/lagrangian", "lagrangian");

@@ -30,6 +30,7 @@ struct Observe {
 };
 
 struct Scene {
+  std::string text;  // the scene's JSON (as parsed, compact), for outputs that carry it
   const Construction* construction = nullptr;  // method.construction, from the table
   std::shared_ptr<const MethodOptions> method_options;  // its own keys of "method", read by it
   PluginSpec manifold, lagrangian;
