@@ -7,6 +7,7 @@ packages=(
   libeigen3-dev libboost-dev nlohmann-json3-dev libfmt-dev doctest-dev libcli11-dev
   libvalijson-dev gnuplot-nox libhdf5-dev
   clang libclang-rt-14-dev  # the scene fuzzer (ctest -L fuzz): libFuzzer
+  gfortran  # bench_gni: the GNI peer (../shared/peers/gni) it times varia against
 )
 missing=()
 for p in "${packages[@]}"; do

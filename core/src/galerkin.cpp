@@ -132,6 +132,11 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   if (explicit_form_applies(quadrature))
     explicit_advance_ = for_dimension(
         n_, [](auto N) -> AdvanceFunction { return &GalerkinDiscreteLagrangian::explicit_advance<decltype(N)::value>; });
+  else if (simplified_applies())
+    for_dimension(n_, [this](auto N) {
+      simplified_solve_ = &GalerkinDiscreteLagrangian::solve_simplified<decltype(N)::value>;
+      predict_ = &GalerkinDiscreteLagrangian::predict<decltype(N)::value>;
+    });
 }
 
 const EvaluationCounters& GalerkinDiscreteLagrangian::evaluations() const {
@@ -164,6 +169,42 @@ bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
   increment_.resize(n_);
   last_q_.resize(n_);
   last_p_.resize(n_);
+  return true;
+}
+
+// A constant mass matrix, no forces (f(v) would add to the kinetic part), a dense Jacobian; M
+// symmetric positive definite (the Lagrangian hyperregular), and the stiffness matrix's block for
+// the step's equations invertible (it is: K's kernel is the constants, and its rows sum to 0).
+bool GalerkinDiscreteLagrangian::simplified_applies() {
+  if (!forces_.empty() || lagrangian_.sparse()) return false;
+  mass_matrix_.resize(n_, n_);
+  if (!lagrangian_.plugin().constant_mass_matrix(mass_matrix_.data())) return false;
+  const Eigen::LLT<Eigen::MatrixXd> mass(mass_matrix_);
+  if (mass.info() != Eigen::Success) return false;
+  inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
+  stiffness_ = Eigen::MatrixXd::Zero(s_ + 1, s_ + 1);
+  for (int i = 0; i < basis_.dphi.cols(); ++i)
+    stiffness_.noalias() += weights_[i] * basis_.dphi.col(i) * basis_.dphi.col(i).transpose();
+  const Eigen::FullPivLU<Eigen::MatrixXd> block(stiffness_.block(0, 1, s_, s_));
+  if (!block.isInvertible()) return false;
+  stiffness_inverse_ = block.inverse();
+  restart_.resize(n_, s_ + 1);
+  const int r = static_cast<int>(nodes_.size());
+  node_forces_ = Eigen::MatrixXd::Zero(n_, r);
+  previous_forces_ = node_forces_;
+  predicted_.resize(s_ * n_);
+  kinetic_.resize((s_ + 1) * n_);
+  Eigen::MatrixXd extrapolation = Eigen::MatrixXd::Zero(r, r), weights(r, s_);
+  for (int i = 0; i < r; ++i) {
+    weights.row(i) = weights_[i] * basis_.phi.col(i).head(s_).transpose();
+    for (int j = 0; j < r && weights_[i] != 0.0; ++j) {
+      double l = 1.0;
+      for (int m = 0; m < r; ++m)
+        if (m != i && weights_[m] != 0.0) l *= (1.0 + nodes_[j] - nodes_[m]) / (nodes_[i] - nodes_[m]);
+      extrapolation(i, j) = l;
+    }
+  }
+  force_prediction_ = extrapolation * weights;
   return true;
 }
 
@@ -289,8 +330,8 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
   const bool sparse = lagrangian_.sparse();
   double S = 0.0;
   if (order != Order::value) {
-    gradient_.setZero();
-    impulse_.setZero();
+    for (int k = 0; k < (s_ + 1) * n; ++k) gradient_[k] = 0.0;
+    for (int c = 0; c < n; ++c) impulse_[c] = 0.0;
   }
   if (order == Order::hessian && sparse) sparse_.matrix.coeffs().setZero();
   if (order == Order::hessian && !sparse) hessian_.setZero();
@@ -302,14 +343,19 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
       L = lagrangian_.sparse_hessian(q_.data(), v_.data(), grad_.data(), sparse_values_.data());
     else if (order == Order::hessian)
       L = lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data());
-    else if (order == Order::gradient)
+    else if (order == Order::value_and_gradient)
       L = lagrangian_.value_and_gradient(q_.data(), v_.data(), grad_.data());
+    else if (order == Order::gradient)
+      lagrangian_.gradient(q_.data(), v_.data(), grad_.data());
     else
       L = lagrangian_.value(q_.data(), v_.data());
     const double b = weights_[i];
     S += h * b * L;
     if (order == Order::value) continue;
-    impulse_ += (h * b) * grad_.head(n);
+    for (int c = 0; c < n; ++c) {
+      impulse_[c] += (h * b) * grad_[c];
+      if (predict_ != nullptr) node_forces_(c, i) = grad_[c];
+    }
     if (forced) add_forces(i, h, order);
     if (order == Order::hessian && sparse)
       add_sparse_entries(i, h, 0, sparse_values_.data(), static_cast<int>(sparse_values_.size()), h * b);
@@ -426,6 +472,126 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
   sparse_.analyzed = false;
 }
 
+// ---- simplified Newton for a constant mass matrix (galerkin.hpp) -----------------------------
+// The step's equations, nu = 0..s-1, in the offsets X^mu = q^mu - q^0 (mu = 1..s, X^0 = 0),
+//   F^nu = p0 delta_nu0 + (1/h) M sum_mu K_numu X^mu + h sum_i b_i l_nu(c_i) g_i,  g_i = dL/dq(q_i),
+// (dS/dq^nu of action() with L_v = M v summed analytically), and their kinetic part's inverse. Plain
+// loops over a handful of numbers, n fixed for n <= 4: at these sizes a dynamic-size product's
+// setup costs more than its arithmetic. K is stiffness_ ((s+1) x (s+1)), K^{-1} the inverse of its
+// block K(0..s-1, 1..s) (stiffness_inverse_), both column-major.
+
+// F at the control points in points_ into F (s n): action()'s dS/dq^nu (the plugin's L_v, not
+// K M q^mu / h: K's entries are rounded once, and that rounding, the same at every step, moved the
+// solution by an ulp a step), with p0 added to the equation nu = 0. The nodes' forces are kept in
+// node_forces_ for the next step's warm start. Returns F's round-off yardstick, as
+// Equations::evaluate.
+template <int N>
+double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p0, double* F) {
+  const int n = N == Eigen::Dynamic ? n_ : N, s = s_;
+  action_for<N>(h, Order::gradient, false);
+  const double* __restrict gradient = gradient_.data();
+  double yardstick = 0.0;
+  for (int k = 0; k < (s + 1) * n; ++k) yardstick = std::max(yardstick, std::abs(gradient[k]));
+  for (int k = 0; k < s * n; ++k) F[k] = gradient[k];
+  for (int c = 0; c < n; ++c) {
+    F[c] += p0[c];
+    yardstick = std::max(yardstick, std::abs(p0[c]));
+  }
+  return yardstick;
+}
+
+// update^mu = h M^{-1} sum_nu (K^{-1})_{mu nu} F^nu (update and F: s n).
+template <int N>
+void GalerkinDiscreteLagrangian::simplified_update(double h, const double* F, double* update) {
+  const int n = N == Eigen::Dynamic ? n_ : N, s = s_;
+  const double* __restrict K_inverse = stiffness_inverse_.data();
+  const double* __restrict M_inverse = inverse_mass_.data();
+  double* __restrict combined = kinetic_.data();
+  for (int mu = 0; mu < s; ++mu) {
+    for (int c = 0; c < n; ++c) combined[c] = 0.0;
+    for (int nu = 0; nu < s; ++nu)
+      for (int c = 0; c < n; ++c) combined[c] += K_inverse[mu + nu * s] * F[nu * n + c];
+    for (int c = 0; c < n; ++c) {
+      double m = 0.0;
+      for (int d = 0; d < n; ++d) m += M_inverse[c + d * n] * combined[d];
+      update[mu * n + c] = h * m;
+    }
+  }
+}
+
+// The step's equations as a NewtonSolver system with the simplified Jacobian: solve() applies its
+// inverse, finish() brings dS/dq^nu up to date by the kinetic part of the last update (exactly:
+// it is linear; the forces' part of the change is the residual the stopping rule leaves, below
+// F's rounding).
+template <int N>
+struct GalerkinDiscreteLagrangian::Simplified {
+  GalerkinDiscreteLagrangian& g;
+  double h;
+  const double* p0;
+
+  int size() const { return g.s_ * g.n_; }
+  bool simplified() const { return true; }
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.simplified_residual<N>(h, p0, F.data()); }
+  void factorize() {}  // K^{-1} and M^{-1} are formed when the map is built
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { g.simplified_update<N>(h, F.data(), update.data()); }
+  double apply(const Eigen::VectorXd& update) {
+    const int n = N == Eigen::Dynamic ? g.n_ : N, size = g.s_ * n;
+    double* __restrict points = g.points_.data() + n;
+    double largest = 0.0, origin = 0.0;
+    for (int k = 0; k < size; ++k) {
+      points[k] -= update[k];
+      largest = std::max(largest, std::abs(points[k]));
+    }
+    for (int c = 0; c < n; ++c) origin = std::max(origin, std::abs(g.origin_[c]));
+    return origin + largest;
+  }
+  void finish(const Eigen::VectorXd& update) {
+    const int n = N == Eigen::Dynamic ? g.n_ : N, s = g.s_;
+    const double* __restrict K = g.stiffness_.data();
+    const double* __restrict M = g.mass_matrix_.data();
+    double* __restrict kinetic = g.kinetic_.data();
+    for (int nu = 0; nu < s; ++nu) {
+      for (int c = 0; c < n; ++c) kinetic[c] = 0.0;
+      for (int mu = 1; mu <= s; ++mu)
+        for (int c = 0; c < n; ++c) kinetic[c] += K[nu + mu * (s + 1)] * update[(mu - 1) * n + c];
+      for (int c = 0; c < n; ++c) {
+        double m = 0.0;
+        for (int d = 0; d < n; ++d) m += M[c + d * n] * kinetic[d];
+        g.gradient_[nu * n + c] -= m / h;
+      }
+    }
+  }
+};
+
+template <int N>
+bool GalerkinDiscreteLagrangian::solve_simplified(double h, const double* p0) {
+  Simplified<N> equations{*this, h, p0};
+  return solver_.solve(equations, statistics_).converged();
+}
+
+// The warm start: the step's equations are linear in the control points once the forces g_i are
+// given. With the last step's forces continued as the polynomial through its nodes,
+// g_j ~ sum_i l_i(1 + c_j) g_i^prev (force_prediction_ holds those weights times b_j l_nu(c_j)),
+// they are solved for the control points by the simplified Jacobian. The forces along the motion
+// are as smooth as the motion: the extrapolated forces are off by O(h^r) (r nodes), the control
+// points by O(h^(r+2)) (the kinetic part's inverse is O(h), times h), against O(h^(s+1)) for the
+// last step's interpolant continued (which Newton's method with the exact Jacobian starts from).
+template <int N>
+void GalerkinDiscreteLagrangian::predict(const double* p0, double h) {
+  const int n = N == Eigen::Dynamic ? n_ : N, s = s_, r = static_cast<int>(weights_.size());
+  const double* __restrict forces = previous_forces_.data();
+  const double* __restrict weights = force_prediction_.data();
+  double* __restrict equations = predicted_.data();
+  for (int nu = 0; nu < s; ++nu)
+    for (int c = 0; c < n; ++c) {
+      double sum = 0.0;
+      for (int i = 0; i < r; ++i) sum += weights[i + nu * r] * forces[i * n + c];
+      equations[nu * n + c] = h * sum + (nu == 0 ? p0[c] : 0.0);
+    }
+  simplified_update<N>(h, equations, change_.data());
+  for (int k = 0; k < s * n; ++k) points_.data()[n + k] = -change_[k];
+}
+
 // The equations dS/dq^nu (+ f_d^nu when forced) = 0, nu in [first_equation, first_equation +
 // blocks), in the control points [first_unknown, first_unknown + blocks), with p0 (if not null)
 // added to the equation nu = 0 (IDEL: p0 + D1 L_d + f_d^0 = 0), as a system for NewtonSolver
@@ -480,10 +646,17 @@ void GalerkinDiscreteLagrangian::factorize_sparse() {
                            std::nan(""));
 }
 
-// Newton's method with the exact Jacobian (solve/newton.hpp: its stopping rule, and the update
-// from the last residual always applied).
+// Newton's method (solve/newton.hpp: its stopping rule, and the update from the last residual
+// always applied). The step's equations of a constant mass matrix are solved by simplified Newton
+// first, from the warm start; where that does not converge, again from the warm start with the
+// exact Jacobian.
 void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
                                         int blocks, const double* p0, bool forced) {
+  if (simplified_solve_ != nullptr && p0 != nullptr) {
+    restart_ = points_;
+    if ((this->*simplified_solve_)(h, p0)) return;
+    points_ = restart_;
+  }
   if (lagrangian_.sparse()) prepare_sparse(first_unknown, first_equation, blocks);
   const int size = blocks * n_;
   if (!lagrangian_.sparse() && dense_.jacobian.rows() != size) dense_ = DenseLinearization(size);
@@ -513,7 +686,9 @@ void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unkno
 void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
   const Eigen::Map<const Eigen::VectorXd> start(q0, n_);
   origin_ = start;
-  if (has_previous_ && previous_h_ == h && previous_end_ == start) {
+  if (has_previous_ && previous_h_ == h && previous_end_ == start && predict_ != nullptr) {
+    (this->*predict_)(p0, h);
+  } else if (has_previous_ && previous_h_ == h && previous_end_ == start) {
     points_.noalias() = previous_ * extrapolation_;
     points_.colwise() -= previous_.col(s_);
   } else {
@@ -553,6 +728,7 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   end = previous_end_;
   momentum1 = end_p_;
   previous_ = points_;
+  if (predict_ != nullptr) previous_forces_ = node_forces_;
   previous_h_ = h;
   has_previous_ = true;
 }
@@ -563,7 +739,7 @@ void GalerkinDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
   origin_ = a;
   for (int nu = 0; nu <= s_; ++nu) points_.col(nu) = basis_.control_times[nu] * (b - a);
   if (s_ > 1) newton(h, 1, 1, s_ - 1, nullptr, false);
-  const double S = action(h, Order::gradient);
+  const double S = action(h, Order::value_and_gradient);
   if (Ld != nullptr) *Ld = S;
   if (D1 != nullptr) Eigen::Map<Eigen::VectorXd>(D1, n_) = gradient_.head(n_);
   if (D2 != nullptr) Eigen::Map<Eigen::VectorXd>(D2, n_) = gradient_.segment(s_ * n_, n_);

@@ -56,11 +56,6 @@ std::vector<std::string> csv_columns(int point_size, int dim, const Observer& ob
   return columns;
 }
 
-// What the run record reports besides the trajectory's state.
-struct Outcome {
-  double wall_seconds = 0.0;
-};
-
 struct Failure {
   long step;  // the step that failed: from step - 1 to step
   double t;   // the time it started from
@@ -72,7 +67,7 @@ struct Failure {
 
 // Spec "Outputs": the run record's keys.
 json run_record(const Scene& scene, const Assembly& a, const Observer& observer, const Trajectory& state,
-                const Outcome& outcome, const Registry& registry) {
+                const RunOutcome& outcome, const Registry& registry) {
   const auto& statistics = a.map->solver_statistics();
   const auto& evaluations = a.map->evaluations();
   json record{
@@ -94,7 +89,7 @@ json run_record(const Scene& scene, const Assembly& a, const Observer& observer,
 }
 
 void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, const Observer& observer,
-                         const Trajectory& state, const Outcome& outcome) {
+                         const Trajectory& state, const RunOutcome& outcome) {
   const auto& statistics = a.map->solver_statistics();
   const std::string method = scene.construction->describe(scene);
   fmt::print(to, "system            {} on {}\n", scene.lagrangian.type, scene.manifold.type);
@@ -178,7 +173,7 @@ class Stepper {
   }
 
   const Trajectory& state() const { return trajectory_; }
-  const Outcome& outcome() const { return outcome_; }
+  const RunOutcome& outcome() const { return outcome_; }
   const Observer& observer() const { return observer_; }
 
  private:
@@ -219,7 +214,7 @@ class Stepper {
   Assembly& a_;
   Observer observer_;
   Trajectory trajectory_;
-  Outcome outcome_;
+  RunOutcome outcome_;
   std::unique_ptr<CsvWriter> csv_;
   std::unique_ptr<Hdf5Writer> h5_;
   std::unique_ptr<PlotRecorder> plot_;
@@ -235,7 +230,7 @@ json residual_json(double residual) {
 
 }  // namespace
 
-void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options) {
+RunOutcome run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options) {
   Stepper stepper(scene, assembly, options);
   // A plugin fault or an interruption also leaves a run record, noting it (docs/security.md).
   const auto write_record = [&](const json& note) {
@@ -273,6 +268,7 @@ void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry,
   // With the trajectory on stdout, the human summary goes to stderr.
   if (!options.quiet) print_human_summary(options.out && *options.out == "-" ? stderr : results(), scene, assembly,
                                           stepper.observer(), stepper.state(), stepper.outcome());
+  return stepper.outcome();
 }
 
 }  // namespace varia::host

@@ -19,9 +19,15 @@ struct RunOptions {
   bool quiet = false;                             // no progress line, no human summary
 };
 
+// What the run record reports besides the trajectory's state: the seconds of the stepping loop
+// with its observing and writing (the record's wall_seconds; the benchmarks read it).
+struct RunOutcome {
+  double wall_seconds = 0.0;
+};
+
 // Steps the scene's integrator to its last step. On a NumericalFailure the rows written so far
 // stay whole, the run record is written with a "failure" key, and a NumericalFailure naming the
 // step index, time and residual is thrown.
-void run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options);
+RunOutcome run_scene(const Scene& scene, Assembly& assembly, const Registry& registry, const RunOptions& options);
 
 }  // namespace varia::host

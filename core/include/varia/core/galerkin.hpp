@@ -4,7 +4,17 @@
 // control points:
 //   L_d(q0, q1) = ext_{q^1..q^{s-1}} h sum_i b_i L(q(c_i h), qdot(c_i h)).
 // Its discrete Hamiltonian map solves the IDEL equations p0 = -D1 L_d, p1 = D2 L_d together with
-// the internal stationarity conditions by Newton's method with the exact Jacobian.
+// the internal stationarity conditions by Newton's method with the exact Jacobian; for
+// L = 1/2 v^T M v - V(q) with a constant mass matrix M (and no forces) by simplified Newton:
+// the equations are
+//   p0 delta_nu0 + (1/h) sum_mu K_numu M q^mu - h sum_i b_i l_nu(c_i) grad V(q(c_i h)) = 0,
+// with the stiffness matrix K_numu = sum_i b_i l'_nu(c_i) l'_mu(c_i) of the interpolant, and their
+// kinetic part (1/h) K (x) M, constant, is the Jacobian that the iteration keeps (factorized once,
+// when the map is built): each iteration evaluates the forces dL/dq at the nodes only, no
+// Hessian. This is the fixed-point iteration of the s-stage Gauss method (s Gauss-Legendre
+// points) for q'' = -M^{-1} grad V, whose contraction is O(h^2 |M^{-1} V''|). Where it does not
+// contract (theta >= 1/2: large steps, stiff forces) the step is solved again with the exact
+// Jacobian.
 // Forces (force.hpp) enter by the discrete Lagrange-d'Alembert principle (Marsden & West 2001,
 // sec. 3.2) with the discrete forces taken through the same quadrature,
 //   f_d^nu = h sum_i b_i l_nu(c_i) f(t + c_i h, q(c_i h), qdot(c_i h)),
@@ -68,7 +78,9 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void take_steps(double* q, double* p, double t0, double h, long steps, double* q1, double* p1) override;
 
  private:
-  enum class Order { value, gradient, hessian };
+  // value: S only; gradient: dS/dq without S (the plugin is not asked for L); value_and_gradient;
+  // hessian: S, dS/dq and d2S/dq2.
+  enum class Order { value, gradient, value_and_gradient, hessian };
   // The discrete action S(q^0..q^s) = h sum_i b_i L(q(c_i h), qdot(c_i h)) of the control points
   // in points_, with its gradient dS/dq^nu in gradient_ and Hessian in hessian_ (sparse: in
   // sparse_.matrix) up to `order`; with `forced`, f_d^nu is added to gradient_ and its Jacobian to
@@ -100,6 +112,23 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void newton(double h, int first_unknown, int first_equation, int blocks, const double* p0,
               bool forced);
   struct Equations;  // those equations as a NewtonSolver system
+  // Simplified Newton on the step's equations (nu = 0..s-1, unknowns q^1..q^s) of a constant mass
+  // matrix: their residual from the forces at the nodes, the update by the kinetic part's inverse,
+  // the solve (true when it converged), and the warm start predicted from the last step's forces.
+  // Compiled for N = n <= 4 and Dynamic, chosen once (simplified_solve_, predict_).
+  bool simplified_applies();
+  template <int N>
+  struct Simplified;  // those equations as a NewtonSolver system
+  template <int N>
+  double simplified_residual(double h, const double* p0, double* F);
+  template <int N>
+  void simplified_update(double h, const double* F, double* update);
+  template <int N>
+  bool solve_simplified(double h, const double* p0);
+  template <int N>
+  void predict(const double* p0, double h);
+  using SimplifiedFunction = bool (GalerkinDiscreteLagrangian::*)(double, const double*);
+  using PredictFunction = void (GalerkinDiscreteLagrangian::*)(const double*, double);
   void factorize_sparse();
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
@@ -168,6 +197,19 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // and, at the last (q1, p1) with step previous_h_, dL/dq and the increment h v (reused by a step
   // from there: one gradient evaluation per step).
   AdvanceFunction explicit_advance_ = nullptr;
+  // Simplified Newton (constant mass matrix): the stiffness matrix K ((s+1) x (s+1)), the inverse
+  // of its block K(0..s-1, 1..s), M^{-1} (inverse_mass_), and a copy of the step's unknowns to
+  // solve again from with the exact Jacobian. Its warm start (predict()): the forces dL/dq at the
+  // nodes of the last evaluation (node_forces_, n x r) and of the last step (previous_forces_),
+  // and force_prediction_ (r x s): the extrapolation of the nodes' forces to the next step's
+  // nodes (l_i(1 + c_j), the Lagrange basis through the nodes) times the weights b_j l_nu(c_j) of
+  // the step's equations. Workspace: the equations' value at the predicted forces (s n), and
+  // products of the kinetic part ((s+1) n).
+  SimplifiedFunction simplified_solve_ = nullptr;
+  PredictFunction predict_ = nullptr;
+  Eigen::MatrixXd stiffness_, stiffness_inverse_, restart_;
+  Eigen::MatrixXd node_forces_, previous_forces_, force_prediction_;
+  Eigen::VectorXd predicted_, kinetic_;
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;
   Eigen::VectorXd force_, increment_, last_q_, last_p_;

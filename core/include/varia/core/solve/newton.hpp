@@ -22,8 +22,16 @@
 //       // it derives from F, to first order from the Jacobian at hand.
 //
 // DenseLinearization is factorize() and solve() for a dense Jacobian; a system with a sparse one
-// factorizes it itself. Simplified Newton (a Jacobian kept over several iterations) would
-// factorize less often and take the contraction estimate into the update test below.
+// factorizes it itself.
+//
+// The Jacobian policy. A system may also provide
+//   bool simplified() const;
+// returning true when its solve() uses a constant approximation A of dF/dx (simplified Newton:
+// Hairer & Wanner, "Solving ODEs II", sec. IV.8): the solver then calls factorize() once per
+// solve, and the system may keep its factorization across solves (once per step size), evaluate()
+// need not form the Jacobian, and the iteration converges linearly, with the contraction
+// theta_k = r_k / r_{k-1}, instead of quadratically. Without it (or when it returns false) the
+// Jacobian is exact.
 //
 // The stopping rule. Newton's method with the exact Jacobian reduces the residual quadratically
 // until F's round-off, the attainable accuracy (Deuflhard, "Newton Methods for Nonlinear
@@ -37,6 +45,17 @@
 //     round-off exceeds a few eps of its visible terms when the plugin's own sums cancel (a
 //     configuration-dependent mass matrix, trigonometric functions of large angles); a residual
 //     that stops decreasing there, with an update that small, is converged, never a failure.
+// Simplified Newton ends instead after applying update_k (k >= 1) when
+//   - the residual that update_k leaves, predicted from the contraction as theta_k r_k with
+//     theta_k < 1/2, is below F's own rounding: theta_k r_k <= eps (1 + yardstick of F), eps the
+//     machine epsilon; exact Newton's last update leaves O(r_k^2), which a constant Jacobian does
+//     not (a residual of the tolerance's size left at every step, of the same sign, adds up over
+//     a run as said below);
+//   - or r_k stagnates at round-off, as above, r_k <= tolerance (1 + yardstick of F) (a slow
+//     contraction is not a stagnation).
+//   A simplified iteration that contracts too slowly to be worth going on with (theta_k >= 1/2,
+//   not converged) ends as a failure of its own kind, not_contracting, so that the system can
+//   solve again with the exact Jacobian.
 // The update computed from the last residual is always applied: a residual left at the tolerance
 // has the same sign from step to step and adds up over a run (a conserved momentum drifts
 // linearly), where its update takes it to round-off. The iterations counted are the updates
@@ -47,6 +66,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -91,7 +111,7 @@ class NumericalFailure : public std::runtime_error {
 
 // How a solve ended.
 struct SolveReport {
-  enum class Outcome { converged, non_finite, iteration_limit };
+  enum class Outcome { converged, non_finite, iteration_limit, not_contracting };
   Outcome outcome = Outcome::converged;
   int iterations = 0;     // updates applied
   double residual = 0.0;  // the last residual norm
@@ -104,6 +124,8 @@ inline void require_converged(const SolveReport& report, const char* equations) 
   if (report.converged()) return;
   if (report.outcome == SolveReport::Outcome::non_finite)
     throw NumericalFailure(std::string(equations) + " have a non-finite residual", report.residual);
+  if (report.outcome == SolveReport::Outcome::not_contracting)
+    throw NumericalFailure(std::string("simplified Newton does not contract on ") + equations, report.residual);
   throw NumericalFailure("Newton's method did not converge in " + std::to_string(report.iterations) +
                              " iterations on " + equations,
                          report.residual);
@@ -126,6 +148,7 @@ class DenseLinearization {
 // largest system it has solved: a solve of a system of the same size allocates nothing.
 class NewtonSolver {
  public:
+  static constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   explicit NewtonSolver(SolverOptions options = {}) : options_(options) {
     residuals_.reserve(options_.max_iterations + 1);
   }
@@ -143,6 +166,8 @@ class NewtonSolver {
   // Solves system's F(x) = 0 from its current unknowns, leaving the solution in the system.
   template <class System>
   SolveReport solve(System& system) {
+    bool simplified = false;
+    if constexpr (requires { system.simplified(); }) simplified = system.simplified();
     const int n = system.size();
     if (F_.size() != n) {
       F_.resize(n);
@@ -160,18 +185,26 @@ class NewtonSolver {
         report.outcome = SolveReport::Outcome::non_finite;
         return report;
       }
-      const bool at_round_off = options_.converged(r, yardstick);
+      const bool at_round_off = !simplified && options_.converged(r, yardstick);
+      const double contraction = k == 0 ? 1.0 : residuals_[k - 1] > 0.0 ? r / residuals_[k - 1] : 0.0;
       // The update from a residual at round-off after an iteration reuses the last
       // factorization: the Jacobians differ by O(last update), its error is
       // O(last update x this update).
-      if (k == 0 || !at_round_off) system.factorize();
+      if (k == 0 || (!at_round_off && !simplified)) system.factorize();
       system.solve(F_, update_);
       const double size_of_update = update_.template lpNorm<Eigen::Infinity>();
       const double x_yardstick = system.apply(update_);
       report.iterations = k + 1;
-      if (at_round_off || options_.converged(size_of_update, x_yardstick) ||
-          (!decreasing && size_of_update <= std::sqrt(options_.tolerance) * (1.0 + x_yardstick))) {
+      const bool stagnating = !decreasing && size_of_update <= std::sqrt(options_.tolerance) * (1.0 + x_yardstick);
+      const bool converged =
+          simplified ? (stagnating && options_.converged(r, yardstick)) || (contraction < 0.5 && contraction * r <= kEpsilon * (1.0 + yardstick))
+                     : at_round_off || options_.converged(size_of_update, x_yardstick) || stagnating;
+      if (converged) {
         system.finish(update_);
+        return report;
+      }
+      if (simplified && k > 0 && !(contraction < 0.5)) {
+        report.outcome = SolveReport::Outcome::not_contracting;
         return report;
       }
       if (k == options_.max_iterations) {
