@@ -130,7 +130,7 @@ std::string dense_oscillator_scene(int n) {
 }
 
 TEST_CASE("a dense Lagrangian of more than 4096 position and velocity numbers is refused, exit 2, with the limit, "
-          "why and what to write instead; 4096 are taken") {
+          "why and what to write instead, and 4096 are taken") {
   TempDir dir;
   write_file(dir / "over.json", dense_oscillator_scene(2049));
   check_bad_scene(dir / "over.json",

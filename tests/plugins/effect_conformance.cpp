@@ -14,6 +14,7 @@
 
 #include "../core/fixtures.hpp"
 #include "load_plugin.hpp"
+#include "varia/sdk/conformance/lagrangian.hpp"
 #include "varia/sdk/conformance/plugin.hpp"
 #include "varia/core/composite.hpp"
 #include "varia/core/galerkin.hpp"
@@ -27,6 +28,7 @@ using varia::Effect;
 
 constexpr int kDim = 3;
 const double kMasses[] = {1.0, 2.0, 3.0};
+const double kMasses5[] = {1.0, 2.0, 1.0, 3.0, 1.0};
 
 Json rn(int n) { return {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}}; }
 
@@ -61,6 +63,56 @@ TEST_CASE("effects touch only the coordinates they name, and refuse particles th
   const varia::Status status = spring->bind(kDim, 3, kMasses);
   REQUIRE(status != nullptr);
   CHECK(std::string(status) == "between: particle 5 does not exist (the system has 3)");
+}
+
+namespace {
+
+// A composite of 5 particles in the plane with the given spring terms.
+std::shared_ptr<varia::CompositeLagrangian> springs(const std::vector<Json>& terms) {
+  std::vector<std::shared_ptr<Effect>> effects;
+  for (const Json& term : terms)
+    effects.push_back(varia::test::load_plugin("effect", "spring").create<Effect>(term, rn(10)));
+  return std::make_shared<varia::CompositeLagrangian>(2, std::vector<double>{1, 2, 1, 3, 1}, std::move(effects));
+}
+
+}  // namespace
+
+TEST_CASE("a spring term over a chain or a list of pairs is the sum of the same springs given one by one, with "
+          "the same Hessian pattern") {
+  // A spring of stiffness 2 and rest length 0.5 on the particles given by `key`: `value`.
+  const auto spring = [](const char* key, const Json& value) {
+    return Json{{"stiffness", 2.0}, {"rest_length", 0.5}, {key, value}};
+  };
+  std::vector<Json> one_by_one;
+  for (int i = 0; i < 4; ++i) one_by_one.push_back(spring("between", {i, i + 1}));
+  const auto separate = springs(one_by_one);
+  const auto chain = springs({spring("chain", {0, 4})});
+  const auto pairs = springs({spring("pairs", {{1, 2}, {0, 1}, {3, 2}, {4, 3}})});
+  const VectorXd q = (VectorXd(10) << 0.1, 0.2, 0.9, -0.3, 1.7, 0.4, 2.2, -0.2, 3.1, 0.3).finished();
+  const VectorXd v = VectorXd::LinSpaced(10, -0.5, 0.7);
+  const auto expected = varia::sdk::conformance::evaluate(*separate, q, v);
+  for (const auto& lagrangian : std::vector{chain, pairs}) {
+    const auto e = varia::sdk::conformance::evaluate(*lagrangian, q, v);
+    CHECK(e.value == doctest::Approx(expected.value).epsilon(1e-15));
+    CHECK((e.gradient - expected.gradient).lpNorm<Eigen::Infinity>() <= 1e-15);
+    CHECK((e.hessian - expected.hessian).lpNorm<Eigen::Infinity>() <= 1e-14);
+    const int *rows = nullptr, *cols = nullptr;
+    CHECK(lagrangian->hessian_pattern(&rows, &cols) == separate->hessian_pattern(&rows, &cols));
+  }
+  // A chain of 5 particles in the plane: 10 mass entries, and the 2 x 2 blocks of each particle with
+  // itself and its neighbours (5 + 2 x 4 blocks).
+  const int *rows = nullptr, *cols = nullptr;
+  CHECK(chain->hessian_pattern(&rows, &cols) == 10 + 4 * (5 + 2 * 4));
+}
+
+TEST_CASE("a spring chain must run forward over particles that exist") {
+  auto plugin = varia::test::load_plugin("effect", "spring");
+  CHECK_THROWS_WITH(plugin.create<Effect>({{"chain", {2, 2}}}, rn(10)),
+                    "parameter 'chain' must be [first, last] with first < last, got [2,2]");
+  auto beyond = plugin.create<Effect>({{"chain", {0, 7}}}, rn(10));
+  const varia::Status status = beyond->bind(2, 5, kMasses5);
+  REQUIRE(status != nullptr);
+  CHECK(std::string(status) == "chain: particle 5 does not exist (the system has 5)");
 }
 
 namespace {

@@ -92,7 +92,7 @@ TEST_CASE("gravitation: two bodies move relative to each other on the Kepler orb
 
 TEST_SUITE("long") {
   TEST_CASE("the outer solar system (HLW I.2.3) with Galerkin of degree 4 and 4 Gauss points at h = 100 days ends "
-            "within 1e-9 AU of HLW's reference after 500000 days; the 2-stage Gauss method does not") {
+            "within 1e-9 AU of HLW's reference after 500000 days and the 2-stage Gauss method does not") {
     // Jupiter, Saturn, Uranus, Neptune, Pluto, the Sun; AU, solar masses, days (HLW's data, the same as
     // Hairer's problem.f, IPROB 4, and scenes/effects/outer-solar-system.json).
     const std::vector<double> masses{0.000954786104043, 0.000285583733151, 0.0000437273164546, 0.0000517759138449,

@@ -17,7 +17,8 @@ class Effect : public PluginObject {
   virtual Status bind(int space_dim, int particles, const double* masses) noexcept = 0;
   // The coordinates V depends on: their number k, and their indices into q in *indices.
   virtual int coordinates(const int** indices) const noexcept = 0;
-  // The stored entries of the k x k Hessian of V, as (row, col) indices into x (both triangles).
+  // The stored entries of the k x k Hessian of V, as (row, col) indices into x (both triangles);
+  // an entry may repeat, and its values then add.
   virtual int hessian_pattern(const int** rows, const int** cols) const noexcept = 0;
   // V(x) at the gathered coordinates x[j] = q[indices[j]]; the gradient dV/dx (k numbers); the
   // Hessian values, one per pattern entry. Any output may be null.

@@ -74,9 +74,16 @@ class ParticleEffect : public Effect {
   }
   // Every entry of the k x k Hessian, column-major: the values are a dense matrix.
   void dense_pattern() {
-    const int k = static_cast<int>(indices_.size());
-    for (int c = 0; c < k; ++c)
-      for (int r = 0; r < k; ++r) {
+    std::vector<int> all(indices_.size());
+    for (std::size_t j = 0; j < all.size(); ++j) all[j] = static_cast<int>(j);
+    block_pattern(all);
+  }
+  // Appends the entries (r, c) for every r, c in `coordinates` (positions in the coordinates,
+  // not indices into q), column-major: a dense block over them. Blocks may overlap (several
+  // springs at one particle): the composite adds the values of a repeated entry.
+  void block_pattern(const std::vector<int>& coordinates) {
+    for (int c : coordinates)
+      for (int r : coordinates) {
         rows_.push_back(r);
         cols_.push_back(c);
       }
