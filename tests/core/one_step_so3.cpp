@@ -101,7 +101,7 @@ TEST_CASE("RK and SRK in the embedding are of order 2 on SO(3), Crouch-Grossman 
 // Figure 1 (b), (c): the Lie group methods stay on SO(3) to round-off, SRK to its solver's
 // tolerance (R R^T is a quadratic invariant of the embedded equations), RK leaves it; the energy
 // of the variational LGVI stays bounded, RK's drifts.
-TEST_CASE("Figure 1: orthogonality at round-off for LGVI and LGM, drifting for RK; energy") {
+TEST_CASE("Figure 1: orthogonality at round-off for LGVI and LGM, drifting for RK, energy") {
   Problem p = heavy_top();
   Rotations group;
   const double h = 0.05;

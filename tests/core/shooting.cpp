@@ -193,7 +193,7 @@ TEST_CASE("shooting D1 and D2 are the derivatives of L_d") {
   }
 }
 
-TEST_CASE("SVIMID's discrete Lagrangian is self-adjoint: L_d(q0, q1; h) = -L_d(q1, q0; -h)") {
+TEST_CASE("SVIMID's discrete Lagrangian is self-adjoint: L_d(q0, q1, h) = -L_d(q1, q0, -h)") {
   SeparablePendulum pendulum;
   auto rule = trapezoid();
   auto method = implicit_midpoint();
@@ -300,7 +300,7 @@ TEST_CASE("a shooting solve that does not converge raises a numerical failure") 
   }
 }
 
-TEST_CASE("without a declared constant mass matrix the lagrangian form is refused; the hamiltonian form and the "
+TEST_CASE("without a declared constant mass matrix the lagrangian form is refused, the hamiltonian form and the "
           "one-step construction integrate (q, p) through the exact inverse Legendre transform, giving the "
           "declared-mass trajectory to round-off") {
   Pendulum pendulum;  // declares no mass matrix: v(q, p) by Newton's method, at doubles and at jets

@@ -54,7 +54,7 @@ TEST_CASE("order fit drops round-off and pre-asymptotic points and finds the slo
   CHECK(fit.dropped.size() >= 1);
 }
 
-TEST_CASE("galerkin with the trapezoid rule is self-adjoint; with a one-sided rule it is not") {
+TEST_CASE("galerkin with the trapezoid rule is self-adjoint, with a one-sided rule it is not") {
   FlatSpace space(1);
   Pendulum pendulum;
   const double q = 0.4, v = 0.3, h = 0.1;
@@ -87,7 +87,7 @@ TEST_CASE("the symplecticity defect is at round-off for galerkin and large for e
   CHECK(naive.defect > 1e-3);
 }
 
-TEST_CASE("the energy error of galerkin does not drift; that of explicit Euler does") {
+TEST_CASE("the energy error of galerkin does not drift, that of explicit Euler does") {
   FlatSpace space(1);
   Pendulum pendulum;
   auto rule = trapezoid();

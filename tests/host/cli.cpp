@@ -134,7 +134,7 @@ TEST_CASE("ld --json prints exactly Ld, D1 and D2") {
   CHECK(result["D2"].size() == 2);
 }
 
-TEST_CASE("plugins --json lists the bundled plugins; a junk file in --plugin-path is refused, the rest works") {
+TEST_CASE("plugins --json lists the bundled plugins, a junk file in --plugin-path is refused, the rest works") {
   TempDir dir;
   write_file(dir / "junk.so", "not a library\n");
   const auto listing = run_varia("plugins --json --plugin-path '" + dir.path().string() + "'");
@@ -151,7 +151,7 @@ TEST_CASE("plugins --json lists the bundled plugins; a junk file in --plugin-pat
   CHECK(run_varia("run scenes/default.json --quiet --plugin-path '" + dir.path().string() + "'").code == 0);
 }
 
-TEST_CASE("a solve that does not converge exits 4; the rows written stay whole; the record names the failure") {
+TEST_CASE("a solve that does not converge exits 4, the rows written stay whole, the record names the failure") {
   TempDir dir;
   json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
   scene["method"]["solver"] = {{"tolerance", 1e-300}, {"max_iterations", 1}};

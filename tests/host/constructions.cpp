@@ -95,7 +95,7 @@ json galerkin_with(int degree, const char* rule, int points) {
   return {{"construction", "galerkin"}, {"degree", degree}, {"quadrature", quadrature}};
 }
 
-TEST_CASE("predictions follow the theorems' hypotheses (issue #17, defects 1, 2, 4, 5; each failed on 5dea526)") {
+TEST_CASE("predictions follow the theorems' hypotheses (issue #17, defects 1, 2, 4, 5, each failed on 5dea526)") {
   const json null;
   struct Row {
     const char* what;
@@ -133,7 +133,7 @@ TEST_CASE("predictions follow the theorems' hypotheses (issue #17, defects 1, 2,
 }
 
 TEST_CASE("a galerkin rule too weak to determine the interior control points is refused at /method/quadrature "
-          "(defect 1; on 5dea526 it passed validate and verify exited 4)") {
+          "(defect 1, on 5dea526 it passed validate and verify exited 4)") {
   for (const json& method : {galerkin_with(2, "midpoint", 0), galerkin_with(3, "trapezoid", 0),
                              galerkin_with(4, "simpson", 0)}) {
     CAPTURE(method.dump());

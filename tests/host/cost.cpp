@@ -84,7 +84,7 @@ TEST_CASE("cost names a method by the scene's \"name\" and runs the step sizes g
   CHECK(sweeps.at("Stormer-Verlet").h == std::vector<double>{0.02, 0.01, 0.005});
 }
 
-TEST_CASE("cost on forced scenes (damping, periodic force, both; galerkin and shooting) fits the predicted order 4 "
+TEST_CASE("cost on forced scenes (damping, periodic force, both, galerkin and shooting) fits the predicted order 4 "
           "against a reference run of the forced system") {
   TempDir dir;
   const nlohmann::json base = nlohmann::json::parse(read_file(kSourceDir / "scenes/effects/damped-driven-oscillator.json"));

@@ -31,7 +31,7 @@ TEST_CASE("a composite scene loads its manifold, composite, its effects and its 
   CHECK(record["energy_error_max"].get<double>() < 1e-3);
 }
 
-TEST_CASE("a scene with forces loads and evaluates them; one without evaluates no force") {
+TEST_CASE("a scene with forces loads and evaluates them, one without evaluates no force") {
   const Json forced = run_record("scenes/effects/damped-driven-oscillator.json");
   CHECK(forced["plugins_loaded"] == Json{"Rn", "harmonic-oscillator", "damping", "periodic-force", "gauss-lobatto"});
   CHECK(forced["evaluations"]["force"].get<long>() > 0);
@@ -56,7 +56,7 @@ TEST_CASE("unrelated plugins on the plugin path change neither what a run loads 
   CHECK(b < 3.0 * a + 0.05);
 }
 
-TEST_CASE("a composite's bad term is named by its pointer; forces on a construction without them too") {
+TEST_CASE("a composite's bad term is named by its pointer, forces on a construction without them too") {
   TempDir dir;
   Json scene = Json::parse(read_file(kSourceDir / "scenes/effects/spring-pendulum-2d.json"));
   scene["system"]["lagrangian"]["terms"][1]["particle"] = 4;

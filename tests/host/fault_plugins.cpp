@@ -74,7 +74,7 @@ struct SceneCase {
   const char* reason;  // and what went wrong
 };
 
-TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) naming the file; others run") {
+TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) naming the file, others run") {
   const FaultDirectory faults;
   const SceneCase cases[] = {
       {"pendulum", 0, "", ""},

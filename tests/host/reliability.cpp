@@ -339,7 +339,7 @@ TEST_CASE("cost --out naming a file is bad input (exit 2)") {
 
 // ---- 13: hygiene -------------------------------------------------------------------------------------
 
-TEST_CASE("the scene reader refuses repeated keys, NUL bytes and subnormal numbers; 1.0 is an integer") {
+TEST_CASE("the scene reader refuses repeated keys, NUL bytes and subnormal numbers, 1.0 is an integer") {
   const std::vector<std::tuple<std::string, int, std::string>> cases{
       {R"({"step": 0.1, "step": 0.2})", 2, "/step: a repeated key"},
       {std::string(R"({"a": 1})") + '\0' + "garbage", 2, "NUL"},

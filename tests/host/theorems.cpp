@@ -152,7 +152,7 @@ TEST_CASE("the pendulum's energy error stays bounded without drift over 10^5 gal
   }
 }
 
-TEST_CASE("shooting with rk4 is reported not self-adjoint; with implicit midpoint it is") {
+TEST_CASE("shooting with rk4 is reported not self-adjoint, with implicit midpoint it is") {
   const json pendulum{{"type", "pendulum"}};
   json rk4{{"construction", "shooting"}, {"quadrature", {{"type", "simpson"}}}, {"one_step", {{"type", "rk4"}}}};
   Verified explicit_method(scene_of(pendulum, rk4, 1.0, 0.1));
@@ -267,8 +267,8 @@ TEST_CASE("forced systems: verify measures the order against a reference run of 
   }
 }
 
-TEST_CASE("one-step rk4 on kepler is reported drifting in energy; a variational method on the same orbit is not "
-          "(issue #17, defect 7; this one also passed on 5dea526, whose quarter-against-quarter test caught rk4 too)") {
+TEST_CASE("one-step rk4 on kepler is reported drifting in energy, a variational method on the same orbit is not "
+          "(issue #17, defect 7, this one also passed on 5dea526, whose quarter-against-quarter test caught rk4 too)") {
   const auto kepler = [](const json& method) {
     json document = scene_of({{"type", "kepler"}}, method, 0.0, 0.05);
     document["system"]["manifold"]["dim"] = 2;
@@ -309,7 +309,7 @@ TEST_CASE("ld_order on the planets (scenes/effects/planetary.json) is 4: the L_d
 
 TEST_CASE("orders are fitted on at least four points in the asymptotic range, and an order still rising where round-off "
           "ends the ladder is reported as not measured, never as failing (issue #17, defect 6: kepler e = 0.5 with "
-          "gauss-3 + lobatto-4 shooting, order 6, was fitted on three points as ld_order 0.61; the hard kepler scenes "
+          "gauss-3 + lobatto-4 shooting, order 6, was fitted on three points as ld_order 0.61, the hard kepler scenes "
           "as -0.70 and -2.13)") {
   json document = scene_of({{"type", "kepler"}},
                            {{"construction", "shooting"},
@@ -356,7 +356,7 @@ TEST_CASE("a defect counts as zero only at its measured noise floor, else it is 
 }
 
 TEST_CASE("a predicted order that cannot be measured is reported so and fails verify (issue #17, defect 9: galerkin "
-          "s = 4 exited 0 with every error at round-off); by default verify finds step sizes above round-off") {
+          "s = 4 exited 0 with every error at round-off), by default verify finds step sizes above round-off") {
   const json scene = scene_of({{"type", "pendulum"}}, galerkin(4, "gauss-legendre", 4), 1.3, 0.1);
   const Verified chosen(scene);
   CAPTURE(chosen["global_order"].note);
@@ -379,7 +379,7 @@ TEST_CASE("verify --h sets the step sizes of the order fits (issue #17, defect 1
 
 TEST_CASE("a configuration-dependent mass matrix (the double pendulum): shooting in the hamiltonian form and one-step "
           "gauss collocation integrate (q, p) and measure their predicted orders and symplecticity against a galerkin "
-          "reference; the lagrangian form is refused at /method (issue #18: both were refused)") {
+          "reference, the lagrangian form is refused at /method (issue #18: both were refused)") {
   json scene = bundled_scene("hard/double-pendulum.json");
   scene["initial"] = {{"q", {1.0, 0.5}}, {"v", {0.0, 0.0}}};
   scene["steps"] = 100;

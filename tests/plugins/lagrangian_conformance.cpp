@@ -153,7 +153,7 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "every Lagrangian plugin's parameter schema is a closed object schema; those of "
+    "every Lagrangian plugin's parameter schema is a closed object schema, those of "
     "harmonic-oscillator, pendulum and kepler give every parameter a default and > 0") {
   for (const auto& file : varia::test::plugin_files("lagrangian")) {
     const varia::test::LoadedPlugin plugin(file);
@@ -193,7 +193,7 @@ TEST_CASE("the Lagrangian plugins refuse unsupported manifolds and bad parameter
 }
 
 TEST_CASE(
-    "lagrangian harmonic-oscillator: E = m/2|v|^2 + k/2|q|^2; the exact solution "
+    "lagrangian harmonic-oscillator: E = m/2|v|^2 + k/2|q|^2, the exact solution "
     "solves m q'' = -k q") {
   CHECK(make("harmonic_oscillator", Json::object(), rn(40))->position_size() == 40);  // any dim
   const auto oscillator = make("harmonic_oscillator", {{"mass", 2.0}, {"stiffness", 3.0}}, rn(3));
@@ -204,7 +204,7 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "lagrangian pendulum: E = m l^2/2 v^2 - m g l cos q; the exact solution solves "
+    "lagrangian pendulum: E = m l^2/2 v^2 - m g l cos q, the exact solution solves "
     "q'' = -(g/l) sin q in libration and rotation, either direction, from any angle") {
   const double m = 1.5, l = 0.7, g = 9.81;
   const auto pendulum = make("pendulum", {{"mass", m}, {"length", l}, {"gravity", g}}, rn(1));
@@ -237,7 +237,7 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "lagrangian pendulum: on the separatrix the exact solution is q = 2 gd(w0 t); the upright "
+    "lagrangian pendulum: on the separatrix the exact solution is q = 2 gd(w0 t), the upright "
     "equilibrium stays put up to the growth of one rounding error") {
   const auto pendulum = make("pendulum", {{"gravity", 4.0}}, rn(1));
   const double w0 = 2.0;
@@ -254,7 +254,7 @@ TEST_CASE(
 }
 
 TEST_CASE(
-    "lagrangian kepler: act is a rotation that leaves L invariant; momentum is q x v, "
+    "lagrangian kepler: act is a rotation that leaves L invariant, momentum is q x v, "
     "equivariant") {
   std::mt19937 engine(3);
   for (int dim : {2, 3}) {
@@ -292,7 +292,7 @@ TEST_CASE(
 
 TEST_CASE(
     "lagrangian kepler: the exact solution of a bound orbit solves q'' = -mu q/|q|^3 "
-    "and keeps the angular momentum; unbound orbits are refused") {
+    "and keeps the angular momentum, unbound orbits are refused") {
   for (int dim : {2, 3}) {
     CAPTURE(dim);
     const auto kepler = make("kepler", {{"mu", 1.5}}, rn(dim));
