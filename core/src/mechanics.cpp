@@ -1,5 +1,7 @@
 #include "varia/core/mechanics.hpp"
 
+#include <Eigen/Cholesky>
+
 #include <cmath>
 #include <string>
 
@@ -17,6 +19,11 @@ LagrangianEvaluator::LagrangianEvaluator(Lagrangian& lagrangian)
   } else {
     hessian_.resize(m_ + n_, m_ + n_);
     lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
+    Eigen::MatrixXd mass(n_, n_);
+    if (lagrangian_.constant_mass_matrix(mass.data())) {
+      const Eigen::LLT<Eigen::MatrixXd> factor(mass);
+      if (factor.info() == Eigen::Success) inverse_mass_ = factor.solve(Eigen::MatrixXd::Identity(n_, n_));
+    }
   }
 }
 
@@ -28,10 +35,15 @@ void LagrangianEvaluator::not_finite(const char* what) const {
 }
 
 double LagrangianEvaluator::value(const double* q, const double* v) {
+  const double L = unchecked_value(q, v);
+  check_finite(&L, 1, "value");
+  return L;
+}
+
+double LagrangianEvaluator::unchecked_value(const double* q, const double* v) {
   double L = 0.0;
   check(lagrangian_, lagrangian_.evaluate(q, v, &L, nullptr, nullptr), "Lagrangian evaluation");
   ++counters_.lagrangian;
-  check_finite(&L, 1, "value");
   return L;
 }
 
@@ -128,11 +140,19 @@ struct LagrangianEvaluator::InverseLegendre {
 // "Implementation issues": the initial guess for shooting).
 void LagrangianEvaluator::inverse_legendre(const double* q, const double* p, double* v,
                                            const SolverOptions& options) {
+  if (inverse_mass_.size() > 0) {
+    Eigen::Map<Eigen::VectorXd>(v, n_).noalias() = inverse_mass_ * Eigen::Map<const Eigen::VectorXd>(p, n_);
+    return;
+  }
   if (legendre_solver_.options().tolerance != options.tolerance ||
       legendre_solver_.options().max_iterations != options.max_iterations)
     legendre_solver_ = NewtonSolver(options);
   InverseLegendre equations{*this, q, p, Eigen::Map<Eigen::VectorXd>(v, n_)};
   require_converged(legendre_solver_.solve(equations), "the inverse Legendre transform's equations");
+}
+
+double LagrangianEvaluator::energy(const double* q, const double* v, const double* p) {
+  return Eigen::Map<const Eigen::VectorXd>(p, n_).dot(Eigen::Map<const Eigen::VectorXd>(v, n_)) - unchecked_value(q, v);
 }
 
 double LagrangianEvaluator::energy(const double* q, const double* v) {

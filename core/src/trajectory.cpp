@@ -6,7 +6,8 @@ namespace varia {
 
 Trajectory::Trajectory(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q0, const Eigen::VectorXd& p0,
                        double t0, double h)
-    : map_(map), q_(q0), p_(p0), q1_(q0.size()), p1_(p0.size()), t0_(t0), h_(h) {}
+    : map_(map), q_(q0), p_(p0), q1_(q0.size()), p1_(p0.size()), q_start_(q0.size()), p_start_(p0.size()), t0_(t0),
+      h_(h) {}
 
 void Trajectory::step() {
   const double t = time_of(steps_);
@@ -31,6 +32,20 @@ void Trajectory::advance(long count) {
   if (!q_.allFinite() || !p_.allFinite())
     throw StepFailure("a non-finite state", std::nan(""), last, time_of(last - 1));
   steps_ = last;
+}
+
+void Trajectory::advance_checked(long count) {
+  const long start = steps_;
+  q_start_ = q_;
+  p_start_ = p_;
+  try {
+    advance(count);
+  } catch (const StepFailure&) {
+    q_ = q_start_;
+    p_ = p_start_;
+    steps_ = start;
+    for (long k = 0; k < count; ++k) step();  // throws the failure with its step
+  }
 }
 
 }  // namespace varia

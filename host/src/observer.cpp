@@ -25,7 +25,7 @@ void Observer::observe(const double* q, const double* p) {
   values_.clear();
   if (what_.energy || what_.momentum)
     evaluator_.inverse_legendre(q, p, v_.data(), options_);  // warm-started from the last v
-  if (what_.energy) values_.push_back(evaluator_.energy(q, v_.data()));
+  if (what_.energy) values_.push_back(evaluator_.energy(q, v_.data(), p));
   if (what_.momentum) {
     values_.resize(values_.size() + momentum_size_);
     check(lagrangian_, lagrangian_.momentum(q, v_.data(), values_.data() + values_.size() - momentum_size_), "momentum");

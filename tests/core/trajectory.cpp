@@ -69,4 +69,53 @@ TEST_CASE("steps one by one and advance in one stretch take the same steps, to t
   CHECK(stepped.p() == advanced.p());
 }
 
+// A particle drawn into a wall at q = 1, beyond which its potential sqrt(1 - q) is not defined:
+// the explicit Stormer-Verlet form's gradient is NaN there, a NumericalFailure at that step.
+struct Wall : sdk::AutodiffLagrangian<Wall> {
+  Wall() : sdk::AutodiffLagrangian<Wall>(1, 1) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::sqrt;
+    return 0.5 * v(0) * v(0) - sqrt(1.0 - q(0));
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    mass[0] = 1.0;
+    return true;
+  }
+};
+
+TEST_CASE("a stretch that fails is stepped again one step at a time: the failure names its step, the state is "
+          "the last good one") {
+  FlatSpace space(1);
+  Wall wall;
+  FixedRule rule = trapezoid();
+  const auto map = [&] { return GalerkinDiscreteLagrangian(space, wall, rule, equispaced_control_times(1), {}); };
+  auto a = map(), b = map(), c = map();
+  const Eigen::VectorXd p0 = Eigen::VectorXd::Constant(1, 0.2);
+  Trajectory one_by_one(a, kP0, p0, 0.0, 0.5), checked(b, kP0, p0, 0.0, 0.5), plain(c, kP0, p0, 0.0, 0.5);
+  long failed = -1;
+  try {
+    for (int k = 0; k < 100; ++k) one_by_one.step();
+  } catch (const StepFailure& e) {
+    failed = e.step();
+  }
+  REQUIRE(failed > 2);
+  CHECK_THROWS_AS(checked.advance_checked(100), StepFailure);
+  try {
+    Trajectory again(b, kP0, p0, 0.0, 0.5);
+    again.advance_checked(100);
+  } catch (const StepFailure& e) {
+    CHECK(e.step() == failed);
+  }
+  CHECK(checked.steps() == failed - 1);
+  CHECK(checked.q() == one_by_one.q());
+  CHECK(checked.p() == one_by_one.p());
+  // Where it must not hold: advance() alone names the stretch's last step.
+  try {
+    plain.advance(100);
+  } catch (const StepFailure& e) {
+    CHECK(e.step() == 100);
+  }
+}
+
 }  // namespace

@@ -43,10 +43,15 @@ class LagrangianEvaluator {
 
   // p = dL/dv (q, v).
   void legendre(const double* q, const double* v, double* p);
-  // Solves dL/dv (q, v) = p for v by Newton's method from the guess in v (exact Hessian block).
+  // Solves dL/dv (q, v) = p for v by Newton's method from the guess in v (exact Hessian block);
+  // for L = 1/2 v^T M v - V(q) with a constant mass matrix M (dense Lagrangians) v = M^{-1} p,
+  // no evaluation.
   void inverse_legendre(const double* q, const double* p, double* v, const SolverOptions& options);
   // E = <dL/dv, v> - L.
   double energy(const double* q, const double* v);
+  // E = <p, v> - L(q, v) at a v with dL/dv (q, v) = p (from inverse_legendre): L's value only,
+  // not checked (the caller checks E: a finite state's energy may overflow).
+  double energy(const double* q, const double* v, const double* p);
 
  private:
   // Inline, with the message built out of line: the explicit Stormer-Verlet loop makes one such
@@ -57,6 +62,7 @@ class LagrangianEvaluator {
       if (!std::isfinite(values[i])) not_finite(what);
   }
   [[noreturn]] void not_finite(const char* what) const;
+  double unchecked_value(const double* q, const double* v);
   // The gradient, and L where value is not null.
   void evaluate_gradient(const double* q, const double* v, double* value, double* gradient) {
     check(lagrangian_, lagrangian_.evaluate(q, v, value, gradient, nullptr), "Lagrangian gradient");
@@ -72,6 +78,7 @@ class LagrangianEvaluator {
   // Workspace, sized once: an evaluation allocates nothing.
   Eigen::VectorXd sparse_values_, gradient_;
   Eigen::MatrixXd hessian_;                 // dense Lagrangians only
+  Eigen::MatrixXd inverse_mass_;            // M^{-1} of a declared constant mass matrix (dense only), else empty
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;  // dense Lagrangians only
   Eigen::SparseMatrix<double> velocity_block_;  // sparse Lagrangians: d2L/dv2
   Eigen::SparseLU<Eigen::SparseMatrix<double>> sparse_lu_;

@@ -47,6 +47,11 @@ class Trajectory {
   // the benchmarks time, free to keep its state in registers). On failure (StepFailure naming the
   // last step of the stretch) the state is unspecified.
   void advance(long count);
+  // `count` steps by advance(); where the stretch fails, it is stepped again from its start one
+  // step at a time, so that the StepFailure names the step that failed and the state is the last
+  // good one, as with step() (should those steps all succeed, the trajectory goes on from them).
+  // `varia run` takes the steps it neither observes nor writes so.
+  void advance_checked(long count);
   // Steps to `last` (a total count of steps), calling observe(*this) after every step; stops
   // early when observe returns false (an interrupted run).
   template <class Observe>
@@ -60,6 +65,7 @@ class Trajectory {
  private:
   DiscreteHamiltonianMap& map_;
   Eigen::VectorXd q_, p_, q1_, p1_;
+  Eigen::VectorXd q_start_, p_start_;  // advance_checked's state at the stretch's start
   double t0_, h_;
   long steps_ = 0;
 };
