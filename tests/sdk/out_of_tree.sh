@@ -14,6 +14,10 @@ done
 cmake -S "$source/examples/out-of-tree-plugin" -B "$work/duffing" -G Ninja \
   -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
 cmake --build "$work/duffing" >/dev/null
+# A plugin project that names no build type is built in Release (the package's default).
+cmake -S "$source/examples/out-of-tree-plugin" -B "$work/default" -G Ninja -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
+grep -q '^CMAKE_BUILD_TYPE:STRING=Release$' "$work/default/CMakeCache.txt" ||
+  { echo "a plugin project without a build type is not built in Release" >&2; exit 1; }
 ctest --test-dir "$work/duffing" --output-on-failure >/dev/null
 "$work/prefix/bin/varia-conformance" "$work/duffing/plugins/lagrangian_duffing.so" | grep -q "conforms"
 mkdir -p "$work/dropin" && chmod 755 "$work/dropin"
