@@ -22,23 +22,13 @@ EulerLagrangeField::EulerLagrangeField(LagrangianEvaluator& lagrangian)
   if (constant_mass_) inverse_mass_ = mass_.inverse();
 }
 
-namespace {
-
-LagrangianEvaluator& checked(LagrangianEvaluator& lagrangian, PhaseSpace space) {
+bool declares_constant_mass(const Lagrangian& lagrangian) {
   Eigen::MatrixXd mass(lagrangian.velocity_size(), lagrangian.velocity_size());
-  if (space == PhaseSpace::tangent && !lagrangian.plugin().constant_mass_matrix(mass.data()))
-    throw std::invalid_argument(
-        "the tangent form (q, v) of the Euler-Lagrange field needs a Lagrangian with a constant mass matrix, "
-        "L = 1/2 v^T M v - V(q) (Lagrangian::constant_mass_matrix): with a configuration-dependent one its "
-        "derivatives need L's Hessian at jets, which the Lagrangian interface does not give; this one declares "
-        "none. Integrate in (q, p): the shooting construction's \"form\": \"hamiltonian\"");
-  return lagrangian;
+  return lagrangian.constant_mass_matrix(mass.data());
 }
 
-}  // namespace
-
 MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space, Forces* forces)
-    : EulerLagrangeField(checked(lagrangian, space)),
+    : EulerLagrangeField(lagrangian),
       space_(space),
       forces_(forces != nullptr && !forces->empty() ? forces : nullptr),
       force_(n_),
@@ -55,6 +45,12 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       v_jet_(n_),
       gradient_jet_(2 * n_),
       legendre_residual_(2 * n_) {
+  if (space == PhaseSpace::tangent && !constant_mass_)
+    throw std::invalid_argument(
+        "the tangent form (q, v) of the Euler-Lagrange field needs a Lagrangian with a constant mass matrix, "
+        "L = 1/2 v^T M v - V(q) (Lagrangian::constant_mass_matrix): with a configuration-dependent one its "
+        "derivatives need L's Hessian at jets, which the Lagrangian interface does not give; this one declares "
+        "none. Integrate in (q, p): the shooting construction's \"form\": \"hamiltonian\"");
   v_.setZero();
 }
 

@@ -12,9 +12,8 @@ namespace {
 std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvaluator& lagrangian) {
   if (!manifold.is_vector_space()) return std::make_unique<LieGroupField>(manifold, lagrangian);
   require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");
-  std::vector<double> mass(static_cast<std::size_t>(lagrangian.velocity_size() * lagrangian.velocity_size()));
-  const bool constant = lagrangian.plugin().constant_mass_matrix(mass.data());
-  return std::make_unique<MechanicalField>(lagrangian, constant ? PhaseSpace::tangent : PhaseSpace::cotangent);
+  return std::make_unique<MechanicalField>(
+      lagrangian, declares_constant_mass(lagrangian.plugin()) ? PhaseSpace::tangent : PhaseSpace::cotangent);
 }
 
 }  // namespace

@@ -39,6 +39,9 @@ enum class PhaseSpace { tangent, cotangent };
 void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian,
                           const char* construction);
 
+// Whether the Lagrangian declares a constant mass matrix (Lagrangian::constant_mass_matrix).
+bool declares_constant_mass(const Lagrangian& lagrangian);
+
 // The Euler-Lagrange vector field of a Lagrangian on a state y = (q, w): q the point (point_size
 // numbers), w the velocity or momentum. It drives one step of a one-step plugin, turning its
 // Status into the right exception; the derived fields give f for their phase space.
@@ -144,7 +147,7 @@ class MechanicalField final : public EulerLagrangeField {
   std::vector<Jet2> force_jet_;
   // Workspace, sized once.
   Eigen::VectorXd v_, gradient_;
-  Eigen::MatrixXd hessian_, velocity_q_;
+  Eigen::MatrixXd hessian_, velocity_q_;  // velocity_q_: v_q in cotangent_jacobian(), M^{-1} in velocity()
   Eigen::PartialPivLU<Eigen::MatrixXd> mass_lu_;  // L_vv at the last state (not constant_mass())
   std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;
   SolverOptions legendre_options_;
