@@ -346,42 +346,49 @@ class CanonicalChart {
 };
 
 // Central-difference Jacobian of the one-step map in canonical chart coordinates at
-// (xi, pi) = (0, p0), with difference step delta.
-Eigen::MatrixXd jacobian(CanonicalChart& chart, const double* p0, int n, double h, double delta) {
+// (xi, pi) = (0, p0), with difference step steps[j] in coordinate j.
+Eigen::MatrixXd jacobian(CanonicalChart& chart, const double* p0, int n, double h, const Eigen::VectorXd& steps) {
   Eigen::MatrixXd M(2 * n, 2 * n);
   Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * n), plus(2 * n), minus(2 * n);
   for (int i = 0; i < n; ++i) z[n + i] = p0[i];
   for (int j = 0; j < 2 * n; ++j) {
     for (double sign : {1.0, -1.0}) {
       Eigen::VectorXd w = z;
-      w[j] += sign * delta;
+      w[j] += sign * steps[j];
       chart.step(w, h, sign > 0 ? plus : minus);
     }
-    M.col(j) = (plus - minus) / (2 * delta);
+    M.col(j) = (plus - minus) / (2 * steps[j]);
   }
   return M;
 }
 
-double defect(const Eigen::MatrixXd& M) {
+// The defect of S M S^-1, S = diag(1/a, a): the defect in the rescaled coordinates (S is
+// symplectic, so it is zero exactly when M is symplectic).
+double defect(const Eigen::MatrixXd& M, const Eigen::VectorXd& a) {
   const int n = static_cast<int>(M.rows()) / 2;
+  Eigen::VectorXd s(2 * n);
+  s << a.cwiseInverse(), a;
+  const Eigen::MatrixXd scaled = s.asDiagonal() * M * s.cwiseInverse().asDiagonal();
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2 * n, 2 * n);
   J.topRightCorner(n, n).setIdentity();
   J.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
-  return (M.transpose() * J * M - J).cwiseAbs().maxCoeff();
+  return (scaled.transpose() * J * scaled - J).cwiseAbs().maxCoeff();
 }
 
 }  // namespace
 
 SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& manifold,
-                                         const double* q0, const double* p0, double h) {
-  // Richardson: (4 M(delta/2) - M(delta)) / 3 cancels the O(delta^2) term of central differences.
-  const double delta = 1e-3;
+                                         const double* q0, const double* p0, double h,
+                                         const Eigen::VectorXd& steps) {
+  // Richardson: (4 M(d/2) - M(d)) / 3 cancels the O(d^2) term of central differences.
   const int n = manifold.dim();
+  const Eigen::VectorXd a = (steps.head(n).array() / steps.tail(n).array()).sqrt();
   CanonicalChart chart(map, manifold, q0);
-  auto richardson = [&](double d) {
-    return Eigen::MatrixXd((4.0 * jacobian(chart, p0, n, h, d / 2) - jacobian(chart, p0, n, h, d)) / 3.0);
+  auto richardson = [&](double factor) {
+    return Eigen::MatrixXd(
+        (4.0 * jacobian(chart, p0, n, h, factor / 2 * steps) - jacobian(chart, p0, n, h, factor * steps)) / 3.0);
   };
-  const double coarse = defect(richardson(delta)), fine = defect(richardson(delta / 2));
+  const double coarse = defect(richardson(1.0), a), fine = defect(richardson(0.5), a);
   return {fine, std::abs(fine - coarse) + 1e-13};
 }
 

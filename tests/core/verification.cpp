@@ -78,13 +78,48 @@ TEST_CASE("the symplecticity defect is at round-off for galerkin and large for e
   GalerkinDiscreteLagrangian galerkin(space, pendulum, rule, equispaced_control_times(2), {});
   ExplicitEuler euler;
   const double q = 1.0, p = 0.2;
-  const auto variational = symplecticity_defect(galerkin, space, &q, &p, 0.1);
-  const auto naive = symplecticity_defect(euler, space, &q, &p, 0.1);
+  const Eigen::VectorXd steps = Eigen::VectorXd::Constant(2, 1e-3);
+  const auto variational = symplecticity_defect(galerkin, space, &q, &p, 0.1, steps);
+  const auto naive = symplecticity_defect(euler, space, &q, &p, 0.1, steps);
   CAPTURE(variational.defect);
   CAPTURE(variational.noise);
   CAPTURE(naive.defect);
   CHECK(variational.defect < 1e-9);
   CHECK(naive.defect > 1e-3);
+}
+
+// A pendulum of unit mass beside one of mass 1e-9 (a planet beside Pluto): difference steps on the
+// scale of each coordinate measure the symplecticity of both; a unit momentum step moves the light
+// one at 1e9 times its speed, and the defect then measures the nonlinearity of that motion.
+struct HeavyAndLight : sdk::AutodiffLagrangian<HeavyAndLight> {
+  static constexpr double light = 1e-9;
+  HeavyAndLight() : sdk::AutodiffLagrangian<HeavyAndLight>(2, 2) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::cos;
+    return 0.5 * v(0) * v(0) + cos(q(0)) + light * (0.5 * v(1) * v(1) + cos(q(1)));
+  }
+};
+
+TEST_CASE("the symplecticity defect takes each coordinate in its own scale") {
+  FlatSpace space(2);
+  HeavyAndLight model;
+  auto rule = lobatto3();
+  GalerkinDiscreteLagrangian galerkin(space, model, rule, equispaced_control_times(2), {});
+  ExplicitEuler euler;
+  const double q[2] = {1.0, 0.5}, p[2] = {0.2, 0.3 * HeavyAndLight::light};
+  Eigen::VectorXd scaled(4);
+  scaled << 1e-3, 1e-3, 1e-3, 1e-3 * HeavyAndLight::light;
+  const auto variational = symplecticity_defect(galerkin, space, q, p, 0.1, scaled);
+  const auto naive = symplecticity_defect(euler, space, q, p, 0.1, scaled);
+  const auto unit = symplecticity_defect(galerkin, space, q, p, 0.1, Eigen::VectorXd::Constant(4, 1e-3));
+  CAPTURE(variational.defect);
+  CAPTURE(variational.noise);
+  CAPTURE(naive.defect);
+  CAPTURE(unit.defect);
+  CHECK(variational.defect < 1e-9);
+  CHECK(naive.defect > 1e-3);
+  CHECK(unit.defect > 1e-3);  // what the unscaled test measured: not the map's symplecticity
 }
 
 TEST_CASE("the energy error of galerkin does not drift, that of explicit Euler does") {
@@ -131,8 +166,9 @@ TEST_CASE("on SO(3), in canonical chart coordinates: the galerkin map is symplec
   double R[9];
   so3::to_row_major(so3::exp(Eigen::Vector3d(0.1, 0.2, 0.3)), R);
   const double Pi[3] = {0.4, 1.6, -1.8};
-  const auto variational = symplecticity_defect(galerkin, group, R, Pi, 0.1);
-  const auto naive = symplecticity_defect(euler, group, R, Pi, 0.1);
+  const Eigen::VectorXd steps = Eigen::VectorXd::Constant(6, 1e-3);
+  const auto variational = symplecticity_defect(galerkin, group, R, Pi, 0.1, steps);
+  const auto naive = symplecticity_defect(euler, group, R, Pi, 0.1, steps);
   CAPTURE(variational.defect);
   CAPTURE(variational.noise);
   CAPTURE(naive.defect);

@@ -307,6 +307,27 @@ TEST_CASE("ld_order on the planets (scenes/effects/planetary.json) is 4: the L_d
   for (const auto& c : v.checks) CHECK_FALSE((c.failed() || c.unmeasured()));
 }
 
+TEST_CASE("the outer solar system (scenes/effects/outer-solar-system.json): ld_order and symplecticity measured on "
+          "the scene's scales, one-step rk4 on it reported not symplectic (issue #17: the generic velocities of 0.3 AU "
+          "a day gave ld_order 0.53, exit 1, and unit difference steps a symplecticity defect of 10.5 within a noise "
+          "floor of 45)") {
+  const json scene = bundled_scene("effects/outer-solar-system.json");
+  const Verified v(scene);
+  CAPTURE(v["ld_order"].note);
+  REQUIRE(v["ld_order"].measured);
+  CHECK(*v["ld_order"].measured >= 8 - 0.3);
+  CAPTURE(v["symplectic"].note);
+  CHECK(v["symplectic"].holds == true);
+  CHECK(v["symplectic"].tolerance < 1e-6);
+  for (const auto& c : v.checks) CHECK_FALSE((c.failed() || c.unmeasured()));
+  json rk4 = scene;
+  rk4["method"] = {{"construction", "one-step"}, {"one_step", {{"type", "rk4"}}}};
+  rk4["t_end"] = 20000;
+  const Verified explicit_rk4(rk4);
+  CAPTURE(explicit_rk4["symplectic"].note);
+  CHECK(explicit_rk4["symplectic"].holds == false);
+}
+
 TEST_CASE("orders are fitted on at least four points in the asymptotic range, and an order still rising where round-off "
           "ends the ladder is reported as not measured, never as failing (issue #17, defect 6: kepler e = 0.5 with "
           "gauss-3 + lobatto-4 shooting, order 6, was fitted on three points as ld_order 0.61, the hard kepler scenes "

@@ -109,13 +109,19 @@ void run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::Vec
 // The one-step map's Jacobian M = d(xi1, pi1)/d(xi0, pi0) in canonical coordinates of T*Q (the
 // natural chart at q0 and its conjugate momenta pi = dexp_{-xi}^T p; (q, p) on a vector space), by
 // central differences with Richardson extrapolation (test of a property, not inside any solve),
-// and its symplecticity defect ||M^T J M - J||_max. `noise` is the change of the defect between
-// two difference steps: the floor below which the defect means nothing.
+// and its symplecticity defect ||M^T J M - J||_max. `steps` holds the difference step of each
+// coordinate (xi_1..xi_n, pi_1..pi_n), each on the scale of its coordinate; the defect is taken in
+// the symplectic rescaling xi_j / a_j, pi_j a_j with a_j^2 = step(xi_j) / step(pi_j), which is the
+// defect in coordinates measured in their own scales (dimensionless, and a light body's entries
+// neither swamp nor vanish beside a heavy one's; unit steps leave the coordinates as they are).
+// `noise` is the change of the defect between two difference steps: the floor below which the
+// defect means nothing.
 struct SymplecticityDefect {
   double defect = 0.0, noise = 0.0;
 };
 SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& manifold,
-                                         const double* q0, const double* p0, double h);
+                                         const double* q0, const double* p0, double h,
+                                         const Eigen::VectorXd& steps);
 
 // The energy error's drift over a run: a least-squares line through E - E0 against time; `trend`
 // is its change over the run, `wander` the largest distance of the error from the line. A drift
