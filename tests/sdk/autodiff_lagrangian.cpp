@@ -118,3 +118,80 @@ TEST_CASE("above the stack size a dense autodiff Lagrangian refuses jet inputs w
   DenseMorseChain small(p);
   CHECK(small.gradient_jet(q.data(), v.data(), nullptr, gradient.data()) == nullptr);
 }
+
+namespace {
+
+// A double pendulum's L = 1/2 v1^2 + 1/2 v2^2 + v1 v2 cos(q1 - q2) + cos q1 (m + n = 4, cross terms in
+// q and v) and a pendulum's (m + n = 2), with their gradients written out for jet arithmetic.
+struct Coupled : varia::sdk::AutodiffLagrangian<Coupled> {
+  Coupled() : varia::sdk::AutodiffLagrangian<Coupled>(2, 2) {}
+  template <class T>
+  T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
+    using std::cos;
+    return 0.5 * v(0) * v(0) + 0.5 * v(1) * v(1) + v(0) * v(1) * cos(q(0) - q(1)) + cos(q(0));
+  }
+  template <class T>
+  static std::vector<T> gradient(const T* q, const T* v) {
+    using std::cos;
+    using std::sin;
+    const T s = sin(q[0] - q[1]), c = cos(q[0] - q[1]);
+    return {-(v[0] * v[1] * s) - sin(q[0]), v[0] * v[1] * s, v[0] + v[1] * c, v[1] + v[0] * c};
+  }
+};
+struct Single : varia::sdk::AutodiffLagrangian<Single> {
+  Single() : varia::sdk::AutodiffLagrangian<Single>(1, 1) {}
+  template <class T>
+  T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
+    using std::cos;
+    using std::sin;
+    return 0.5 * v(0) * v(0) * (2.0 + sin(q(0))) + cos(q(0));
+  }
+  template <class T>
+  static std::vector<T> gradient(const T* q, const T* v) {
+    using std::cos;
+    using std::sin;
+    return {0.5 * v[0] * v[0] * cos(q[0]) - sin(q[0]), v[0] * (2.0 + sin(q[0]))};
+  }
+};
+
+// The largest difference of two jets of N variables (a constant's derivatives are zero).
+double jet_distance(const varia::Jet2& a, const varia::Jet2& b, int N) {
+  auto gradient = [N](const varia::Jet2& j) { return j.constant() ? Eigen::VectorXd::Zero(N).eval() : Eigen::VectorXd(j.gradient); };
+  auto hessian = [N](const varia::Jet2& j) { return j.constant() ? Eigen::MatrixXd::Zero(N, N).eval() : Eigen::MatrixXd(j.hessian); };
+  return std::max({std::abs(a.value - b.value), (gradient(a) - gradient(b)).cwiseAbs().maxCoeff(),
+                   (hessian(a) - hessian(b)).cwiseAbs().maxCoeff()});
+}
+
+// Inputs that are nonlinear functions of `variables` jet variables (so that their Hessians are not
+// zero), the last one a constant.
+template <class Model>
+double jet_deviation(int variables) {
+  Model model;
+  const int m = model.position_size(), k = m + model.velocity_size(), N = variables;
+  std::vector<varia::Jet2> x, z;
+  for (int i = 0; i < N; ++i) x.push_back(varia::Jet2::variable(0.3 + 0.2 * i, N, i));
+  for (int i = 0; i < k; ++i)
+    z.push_back(i == k - 1 ? varia::Jet2(0.7) : sin(x[i % N] * x[(i + 1) % N]) + 0.5 * x[(i + 2) % N] * x[(i + 2) % N]);
+  std::vector<varia::Jet2> gradient(k);
+  varia::Jet2 value;
+  REQUIRE(model.gradient_jet(z.data(), z.data() + m, &value, gradient.data()) == nullptr);
+  const std::vector<varia::Jet2> expected = Model::gradient(z.data(), z.data() + m);
+  varia::sdk::Vec<varia::Jet2> q(m), v(k - m);
+  for (int i = 0; i < k; ++i) (i < m ? q(i) : v(i - m)) = z[i];
+  const varia::Jet2 L = model.template lagrangian<varia::Jet2>(q, v);
+  double worst = jet_distance(value, L, N);
+  for (int i = 0; i < k; ++i) worst = std::max(worst, jet_distance(gradient[i], expected[i], N));
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("gradient_jet at jets of 2, 4 and 6 variables (dual numbers over fixed-size jets) and of 3 and 5 (over "
+          "Jet2) equals jet arithmetic on the written-out gradient (issue #19: a shooting step's time went to dual "
+          "numbers over 1.3 kB jets)") {
+  for (int variables : {2, 3, 4, 5, 6}) {
+    CAPTURE(variables);
+    CHECK(jet_deviation<Single>(variables) < 1e-14);
+    CHECK(jet_deviation<Coupled>(variables) < 1e-14);
+  }
+}

@@ -7,6 +7,11 @@
 //
 // A jet with an empty gradient is a constant (its derivatives are zero); arithmetic mixes
 // constants and variables freely, and doubles convert to constants implicitly.
+//
+// FixedJet<N> is the same jet over exactly N variables, stored in N + N^2 numbers: the SDK
+// evaluates a model at dual numbers over it when a shooting step's jets are few (jets of the
+// plugin interface are Jet2). Both share one arithmetic (JetArithmetic: the chain rule written
+// once, as hidden friends, so that a double converts to a constant jet in mixed expressions).
 #pragma once
 
 #include <Eigen/Core>
@@ -19,60 +24,17 @@ namespace varia {
 
 inline constexpr int kMaxJetVariables = 12;
 
-struct Jet2 {
-  using Gradient = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJetVariables, 1>;
-  using Hessian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJetVariables,
-                                kMaxJetVariables>;
-
-  Jet2() = default;
-  Jet2(double constant) : value(constant) {}  // NOLINT: constants convert implicitly
-  Jet2(const Jet2& other) : value(other.value) { copy_derivatives(other); }
-  Jet2& operator=(const Jet2& other) {
-    value = other.value;
-    if (this != &other) copy_derivatives(other);
-    return *this;
-  }
-  // The independent variable `index` of `count`, at `x`.
-  static Jet2 variable(double x, int count, int index) {
-    Jet2 jet(x);
-    jet.gradient = Gradient::Unit(count, index);
-    jet.hessian = Hessian::Zero(count, count);
-    return jet;
-  }
-  bool constant() const { return gradient.size() == 0; }
-
-  double value = 0.0;
-  Gradient gradient;
-  Hessian hessian;
-
- private:
-  // Copies whole 64-byte blocks of the fixed-capacity storage (the gradient's kMaxJetVariables
-  // numbers, the Hessian's first n^2 rounded up to 8): constant-size copies the compiler inlines. Eigen copies
-  // exactly n and n^2 numbers, by a library call each, which cost more than the copies themselves
-  // for the few variables of a jet (a quarter of a shooting step's time went to them).
-  void copy_derivatives(const Jet2& other) {
-    const auto n = other.gradient.size();
-    gradient.resize(n);
-    hessian.resize(n, n);
-    if (n == 0) return;
-    constexpr std::size_t block = 8 * sizeof(double);
-    static_assert(kMaxJetVariables * kMaxJetVariables % 8 == 0);
-    std::memcpy(gradient.data(), other.gradient.data(), kMaxJetVariables * sizeof(double));
-    for (Eigen::Index k = 0; k < n * n; k += 8) std::memcpy(hessian.data() + k, other.hessian.data() + k, block);
-  }
-};
-
 namespace jet {
 
 // f(a), given f(a.value) and f', f'' there: g = f' a_g, H = f' a_H + f'' a_g a_g^T.
 // Plain loops over the n (at most kMaxJetVariables) variables, one pass over the Hessian: jets
 // are small, and a generic product's setup would cost more than its arithmetic.
-inline Jet2 unary(const Jet2& a, double f, double d1, double d2) {
-  Jet2 r(f);
+template <class J>
+J unary(const J& a, double f, double d1, double d2) {
+  J r(f);
   if (a.constant()) return r;
   const int n = static_cast<int>(a.gradient.size());
-  r.gradient.resize(n);
-  r.hessian.resize(n, n);
+  r.resize(n);
   const double* __restrict g = a.gradient.data();
   const double* __restrict H = a.hessian.data();
   double* __restrict rg = r.gradient.data();
@@ -99,14 +61,14 @@ struct Partials {
 // H = F_a a_H + F_b b_H + F_aa a_g a_g^T + F_ab (a_g b_g^T + b_g a_g^T) + F_bb b_g b_g^T
 //   = F_a a_H + F_b b_H + u a_g^T + w b_g^T,  u = F_aa a_g + F_ab b_g,  w = F_ab a_g + F_bb b_g,
 // in one pass over H (the second-order terms only where a second partial is not zero).
-inline Jet2 binary(const Jet2& a, const Jet2& b, double f, const Partials& d) {
+template <class J>
+J binary(const J& a, const J& b, double f, const Partials& d) {
   if (a.constant()) return unary(b, f, d.b, d.bb);
   if (b.constant()) return unary(a, f, d.a, d.aa);
   assert(a.gradient.size() == b.gradient.size());
   const int n = static_cast<int>(a.gradient.size());
-  Jet2 r(f);
-  r.gradient.resize(n);
-  r.hessian.resize(n, n);
+  J r(f);
+  r.resize(n);
   const double* __restrict ga = a.gradient.data();
   const double* __restrict gb = b.gradient.data();
   const double* __restrict Ha = a.hessian.data();
@@ -131,74 +93,144 @@ inline Jet2 binary(const Jet2& a, const Jet2& b, double f, const Partials& d) {
 
 }  // namespace jet
 
-inline Jet2 operator+(const Jet2& a, const Jet2& b) {
-  return jet::binary(a, b, a.value + b.value, {1, 1, 0, 0, 0});
-}
-inline Jet2 operator-(const Jet2& a, const Jet2& b) {
-  return jet::binary(a, b, a.value - b.value, {1, -1, 0, 0, 0});
-}
-inline Jet2 operator*(const Jet2& a, const Jet2& b) {
-  return jet::binary(a, b, a.value * b.value, {b.value, a.value, 0, 1, 0});
-}
-inline Jet2 operator/(const Jet2& a, const Jet2& b) {
-  const double r = 1.0 / b.value, f = a.value * r;
-  return jet::binary(a, b, f, {r, -f * r, 0, -r * r, 2 * f * r * r});
-}
-inline Jet2 operator-(const Jet2& a) { return jet::unary(a, -a.value, -1, 0); }
-inline Jet2 operator+(const Jet2& a) { return a; }
-inline Jet2& operator+=(Jet2& a, const Jet2& b) { return a = a + b; }
-inline Jet2& operator-=(Jet2& a, const Jet2& b) { return a = a - b; }
-inline Jet2& operator*=(Jet2& a, const Jet2& b) { return a = a * b; }
-inline Jet2& operator/=(Jet2& a, const Jet2& b) { return a = a / b; }
-// Comparisons see the values only (branches in a model pick a smooth piece).
-inline bool operator==(const Jet2& a, const Jet2& b) { return a.value == b.value; }
-inline std::partial_ordering operator<=>(const Jet2& a, const Jet2& b) {
-  return a.value <=> b.value;
-}
+// The arithmetic and elementary functions of a jet type J, by the chain rule (jet::unary,
+// jet::binary). Hidden friends: found by argument-dependent lookup for J, and not templates, so
+// that a double converts to a constant J in mixed expressions.
+template <class J>
+struct JetArithmetic {
+  friend J operator+(const J& a, const J& b) { return jet::binary(a, b, a.value + b.value, {1, 1, 0, 0, 0}); }
+  friend J operator-(const J& a, const J& b) { return jet::binary(a, b, a.value - b.value, {1, -1, 0, 0, 0}); }
+  friend J operator*(const J& a, const J& b) {
+    return jet::binary(a, b, a.value * b.value, {b.value, a.value, 0, 1, 0});
+  }
+  friend J operator/(const J& a, const J& b) {
+    const double r = 1.0 / b.value, f = a.value * r;
+    return jet::binary(a, b, f, {r, -f * r, 0, -r * r, 2 * f * r * r});
+  }
+  friend J operator-(const J& a) { return jet::unary(a, -a.value, -1, 0); }
+  friend J operator+(const J& a) { return a; }
+  friend J& operator+=(J& a, const J& b) { return a = a + b; }
+  friend J& operator-=(J& a, const J& b) { return a = a - b; }
+  friend J& operator*=(J& a, const J& b) { return a = a * b; }
+  friend J& operator/=(J& a, const J& b) { return a = a / b; }
+  // Comparisons see the values only (branches in a model pick a smooth piece).
+  friend bool operator==(const J& a, const J& b) { return a.value == b.value; }
+  friend std::partial_ordering operator<=>(const J& a, const J& b) { return a.value <=> b.value; }
 
-inline Jet2 sin(const Jet2& a) {
-  const double s = std::sin(a.value);
-  return jet::unary(a, s, std::cos(a.value), -s);
-}
-inline Jet2 cos(const Jet2& a) {
-  const double c = std::cos(a.value);
-  return jet::unary(a, c, -std::sin(a.value), -c);
-}
-inline Jet2 tan(const Jet2& a) {
-  const double t = std::tan(a.value), d = 1 + t * t;
-  return jet::unary(a, t, d, 2 * t * d);
-}
-inline Jet2 exp(const Jet2& a) {
-  const double e = std::exp(a.value);
-  return jet::unary(a, e, e, e);
-}
-inline Jet2 log(const Jet2& a) {
-  return jet::unary(a, std::log(a.value), 1 / a.value, -1 / (a.value * a.value));
-}
-inline Jet2 sqrt(const Jet2& a) {
-  const double s = std::sqrt(a.value);
-  return jet::unary(a, s, 0.5 / s, -0.25 / (s * a.value));
-}
-// atan2(y, x): F_y = x/r2, F_x = -y/r2, F_yy = -2xy/r2^2 = -F_xx, F_xy = (y^2 - x^2)/r2^2.
-inline Jet2 atan2(const Jet2& y, const Jet2& x) {
-  const double r2 = x.value * x.value + y.value * y.value, r4 = r2 * r2;
-  const double cross = 2 * x.value * y.value / r4;
-  return jet::binary(y, x, std::atan2(y.value, x.value),
-                     {x.value / r2, -y.value / r2, -cross, (y.value * y.value - x.value * x.value) / r4, cross});
-}
-inline Jet2 abs(const Jet2& a) { return a.value < 0 ? -a : a; }
-// a^b; with a constant exponent only the a-derivatives enter (a may then be negative).
-inline Jet2 pow(const Jet2& a, const Jet2& b) {
-  const double f = std::pow(a.value, b.value);
-  const double fa = b.value * std::pow(a.value, b.value - 1);
-  const double faa = b.value * (b.value - 1) * std::pow(a.value, b.value - 2);
-  if (b.constant()) return jet::unary(a, f, fa, faa);
-  const double l = std::log(a.value);
-  return jet::binary(a, b, f, {fa, f * l, faa, fa * l + f / a.value, f * l * l});
-}
-inline bool isfinite(const Jet2& a) {
-  return std::isfinite(a.value) && a.gradient.allFinite() && a.hessian.allFinite();
-}
+  friend J sin(const J& a) {
+    const double s = std::sin(a.value);
+    return jet::unary(a, s, std::cos(a.value), -s);
+  }
+  friend J cos(const J& a) {
+    const double c = std::cos(a.value);
+    return jet::unary(a, c, -std::sin(a.value), -c);
+  }
+  friend J tan(const J& a) {
+    const double t = std::tan(a.value), d = 1 + t * t;
+    return jet::unary(a, t, d, 2 * t * d);
+  }
+  friend J exp(const J& a) {
+    const double e = std::exp(a.value);
+    return jet::unary(a, e, e, e);
+  }
+  friend J log(const J& a) { return jet::unary(a, std::log(a.value), 1 / a.value, -1 / (a.value * a.value)); }
+  friend J sqrt(const J& a) {
+    const double s = std::sqrt(a.value);
+    return jet::unary(a, s, 0.5 / s, -0.25 / (s * a.value));
+  }
+  // atan2(y, x): F_y = x/r2, F_x = -y/r2, F_yy = -2xy/r2^2 = -F_xx, F_xy = (y^2 - x^2)/r2^2.
+  friend J atan2(const J& y, const J& x) {
+    const double r2 = x.value * x.value + y.value * y.value, r4 = r2 * r2;
+    const double cross = 2 * x.value * y.value / r4;
+    return jet::binary(y, x, std::atan2(y.value, x.value),
+                       {x.value / r2, -y.value / r2, -cross, (y.value * y.value - x.value * x.value) / r4, cross});
+  }
+  friend J abs(const J& a) { return a.value < 0 ? -a : a; }
+  // a^b; with a constant exponent only the a-derivatives enter (a may then be negative).
+  friend J pow(const J& a, const J& b) {
+    const double f = std::pow(a.value, b.value);
+    const double fa = b.value * std::pow(a.value, b.value - 1);
+    const double faa = b.value * (b.value - 1) * std::pow(a.value, b.value - 2);
+    if (b.constant()) return jet::unary(a, f, fa, faa);
+    const double l = std::log(a.value);
+    return jet::binary(a, b, f, {fa, f * l, faa, fa * l + f / a.value, f * l * l});
+  }
+  friend bool isfinite(const J& a) {
+    return std::isfinite(a.value) && a.gradient.allFinite() && a.hessian.allFinite();
+  }
+};
+
+struct Jet2 : JetArithmetic<Jet2> {
+  using Gradient = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxJetVariables, 1>;
+  using Hessian = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxJetVariables,
+                                kMaxJetVariables>;
+
+  Jet2() = default;
+  Jet2(double constant) : value(constant) {}  // NOLINT: constants convert implicitly
+  Jet2(const Jet2& other) : value(other.value) { copy_derivatives(other); }
+  Jet2& operator=(const Jet2& other) {
+    value = other.value;
+    if (this != &other) copy_derivatives(other);
+    return *this;
+  }
+  // The independent variable `index` of `count`, at `x`.
+  static Jet2 variable(double x, int count, int index) {
+    Jet2 jet(x);
+    jet.gradient = Gradient::Unit(count, index);
+    jet.hessian = Hessian::Zero(count, count);
+    return jet;
+  }
+  bool constant() const { return gradient.size() == 0; }
+  // Gives the result r of an operation on jets of n variables its derivatives' size.
+  void resize(int n) {
+    gradient.resize(n);
+    hessian.resize(n, n);
+  }
+
+  double value = 0.0;
+  Gradient gradient;
+  Hessian hessian;
+
+ private:
+  // Copies whole 64-byte blocks of the fixed-capacity storage (the gradient's kMaxJetVariables
+  // numbers, the Hessian's first n^2 rounded up to 8): constant-size copies the compiler inlines. Eigen copies
+  // exactly n and n^2 numbers, by a library call each, which cost more than the copies themselves
+  // for the few variables of a jet (a quarter of a shooting step's time went to them).
+  void copy_derivatives(const Jet2& other) {
+    const auto n = other.gradient.size();
+    gradient.resize(n);
+    hessian.resize(n, n);
+    if (n == 0) return;
+    constexpr std::size_t block = 8 * sizeof(double);
+    static_assert(kMaxJetVariables * kMaxJetVariables % 8 == 0);
+    std::memcpy(gradient.data(), other.gradient.data(), kMaxJetVariables * sizeof(double));
+    for (Eigen::Index k = 0; k < n * n; k += 8) std::memcpy(hessian.data() + k, other.hessian.data() + k, block);
+  }
+};
+
+// A jet over exactly N variables; a constant is one whose derivatives are zero.
+template <int N>
+struct FixedJet : JetArithmetic<FixedJet<N>> {
+  FixedJet() : FixedJet(0.0) {}
+  FixedJet(double constant)  // NOLINT: constants convert implicitly
+      : value(constant), gradient(Eigen::Matrix<double, N, 1>::Zero()), hessian(Eigen::Matrix<double, N, N>::Zero()) {}
+  // Jet2 `jet` of N variables (or a constant) and back.
+  explicit FixedJet(const Jet2& jet) : FixedJet(jet.value) {
+    if (!jet.constant()) gradient = jet.gradient, hessian = jet.hessian;
+  }
+  Jet2 to_jet2() const {
+    Jet2 jet(value);
+    jet.gradient = gradient;
+    jet.hessian = hessian;
+    return jet;
+  }
+  bool constant() const { return false; }
+  void resize(int) {}
+
+  double value;
+  Eigen::Matrix<double, N, 1> gradient;
+  Eigen::Matrix<double, N, N> hessian;
+};
 
 }  // namespace varia
 
@@ -206,15 +238,19 @@ namespace Eigen {
 
 // Jets are real scalars for Eigen (as its own AutoDiffScalar is): Real is the jet itself, so that
 // norms and dot products of jet vectors stay jets, and a double converts to a constant jet.
-template <>
-struct NumTraits<varia::Jet2> : GenericNumTraits<double> {
-  using Real = varia::Jet2;
-  using NonInteger = varia::Jet2;
-  using Nested = varia::Jet2;
+template <class J>
+struct JetNumTraits : GenericNumTraits<double> {
+  using Real = J;
+  using NonInteger = J;
+  using Nested = J;
   using Literal = double;
   enum { IsComplex = 0, IsInteger = 0, IsSigned = 1, RequireInitialization = 1, ReadCost = 1,
          AddCost = 3, MulCost = 3 };
 };
+template <>
+struct NumTraits<varia::Jet2> : JetNumTraits<varia::Jet2> {};
+template <int N>
+struct NumTraits<varia::FixedJet<N>> : JetNumTraits<varia::FixedJet<N>> {};
 
 template <typename BinaryOp>
 struct ScalarBinaryOpTraits<varia::Jet2, double, BinaryOp> {
@@ -223,6 +259,14 @@ struct ScalarBinaryOpTraits<varia::Jet2, double, BinaryOp> {
 template <typename BinaryOp>
 struct ScalarBinaryOpTraits<double, varia::Jet2, BinaryOp> {
   using ReturnType = varia::Jet2;
+};
+template <int N, typename BinaryOp>
+struct ScalarBinaryOpTraits<varia::FixedJet<N>, double, BinaryOp> {
+  using ReturnType = varia::FixedJet<N>;
+};
+template <int N, typename BinaryOp>
+struct ScalarBinaryOpTraits<double, varia::FixedJet<N>, BinaryOp> {
+  using ReturnType = varia::FixedJet<N>;
 };
 
 }  // namespace Eigen

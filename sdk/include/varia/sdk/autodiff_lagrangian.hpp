@@ -20,6 +20,7 @@
 
 #include <Eigen/Core>
 #include <algorithm>
+#include <array>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -75,9 +76,12 @@ class AutodiffLagrangian : public Lagrangian {
       if (m_ + n_ > kStackVariables)
         throw std::length_error("an autodiff Lagrangian evaluates at jets with at most " +
                                  std::to_string(kStackVariables) + " position and velocity numbers together");
-      if (m_ + n_ <= 2) return jet_first_order<2>(q, v, 0, value, gradient);
-      for (int first = 0; first < m_ + n_; first += kJetDirections)
-        jet_first_order<kJetDirections>(q, v, first, first == 0 ? value : nullptr, gradient);
+      switch (jet_variables(q, v)) {
+        case 2: return at_fixed_jets<2>(q, v, value, gradient);
+        case 4: return at_fixed_jets<4>(q, v, value, gradient);
+        case 6: return at_fixed_jets<6>(q, v, value, gradient);
+        default: return at_jets(q, v, value, gradient);
+      }
     });
   }
 
@@ -152,12 +156,38 @@ class AutodiffLagrangian : public Lagrangian {
   }
 #pragma GCC diagnostic pop
 
+  // The number of variables of the jets (q, v) (0 when all are constants).
+  int jet_variables(const Jet2* q, const Jet2* v) const {
+    for (int i = 0; i < m_ + n_; ++i)
+      if (const Jet2& z = at(q, v, m_, i); !z.constant()) return static_cast<int>(z.gradient.size());
+    return 0;
+  }
+  // gradient_jet at jets of N variables: the model at dual numbers over FixedJet<N> (N + N^2
+  // numbers each, every loop of the chain rule of a fixed length), converted from and to Jet2.
+  // A shooting step's jets have twice the manifold's dimension in variables (R^1..R^3).
+  template <int N>
+  void at_fixed_jets(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) const {
+    std::array<FixedJet<N>, kStackVariables> inputs, outputs;
+    FixedJet<N> fixed_value;
+    for (int i = 0; i < m_ + n_; ++i) inputs[i] = FixedJet<N>(at(q, v, m_, i));
+    at_jets(inputs.data(), inputs.data() + m_, value != nullptr ? &fixed_value : nullptr, outputs.data());
+    if (value != nullptr) *value = fixed_value.to_jet2();
+    for (int i = 0; i < m_ + n_; ++i) gradient[i] = outputs[i].to_jet2();
+  }
+  // At jets J: one pass of forward mode over every number of (q, v) up to two of them, else one
+  // per block of kJetDirections.
+  template <class J>
+  void at_jets(const J* q, const J* v, J* value, J* gradient) const {
+    if (m_ + n_ <= 2) return jet_first_order<2>(q, v, 0, value, gradient);
+    for (int first = 0; first < m_ + n_; first += kJetDirections)
+      jet_first_order<kJetDirections>(q, v, first, first == 0 ? value : nullptr, gradient);
+  }
   // L (if value is not null) and the derivatives in the numbers first .. first + K - 1 of (q, v)
   // (those that exist) at jet inputs: forward mode over the jets, one derivative direction per
   // number of the block.
-  template <int K>
-  void jet_first_order(const Jet2* q, const Jet2* v, int first, Jet2* value, Jet2* gradient) const {
-    using JD = JetDual<K>;
+  template <int K, class J>
+  void jet_first_order(const J* q, const J* v, int first, J* value, J* gradient) const {
+    using JD = JetDual<K, J>;
     const int k = m_ + n_, last = std::min(first + K, k);
     Vec<JD> qd(m_), vd(n_);
     for (int i = 0; i < k; ++i) seed(input(qd, vd, i), at(q, v, m_, i), K, i - first);

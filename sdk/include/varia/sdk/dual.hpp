@@ -40,9 +40,10 @@ template <int K>
 using FixedDual = Eigen::AutoDiffScalar<Eigen::Matrix<double, K, 1>>;
 template <int K>
 using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
-// A dual number over jets with K derivative directions.
-template <int K>
-using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<Jet2, K, 1>>;
+// A dual number over jets J (Jet2, or FixedJet<N> for jets of N variables) with K derivative
+// directions.
+template <int K, class J = Jet2>
+using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<J, K, 1>>;
 // The large systems' dual numbers: kChunkDirections directions (fewer in the last chunk).
 using ChunkDual = Eigen::AutoDiffScalar<Bounded<double, kChunkDirections>>;
 using ChunkDual2 = Eigen::AutoDiffScalar<Bounded<ChunkDual, kChunkDirections>>;
@@ -64,7 +65,7 @@ template <class T>
 using Vec = Eigen::Matrix<T, Eigen::Dynamic, 1, 0, OnStack<T>::value ? kStackVariables : Eigen::Dynamic, 1>;
 
 // The first-order variable x along direction `direction` of `size` (none when direction is
-// outside [0, size)). X is double, or Jet2 for a dual number over jets.
+// outside [0, size)). X is double, or a jet for a dual number over jets.
 template <class D, class X>
 void seed(D& z, const X& x, int size, int direction) {
   z.value() = x;
