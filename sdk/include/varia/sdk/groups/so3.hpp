@@ -103,8 +103,8 @@ class RotationGroup : public LieGroupManifold<Rotations> {
     const bool with_point = point.value != nullptr || point.gradient != nullptr || point.hessian != nullptr;
     const bool with_velocity =
         velocity.value != nullptr || velocity.gradient != nullptr || velocity.hessian != nullptr;
-    so3::chart_jets(q0, xi, xi_dot, with_point ? point_.data() : nullptr,
-                    with_velocity ? velocity_.data() : nullptr);
+    so3::chart_jets(q0, xi, xi_dot, with_point ? point_.data() : nullptr, with_velocity ? velocity_.data() : nullptr,
+                    point.hessian != nullptr, velocity.hessian != nullptr);
     if (with_point) store(point_.data(), 9, 6, point);
     if (with_velocity) store(velocity_.data(), 3, 6, velocity);
     return nullptr;
