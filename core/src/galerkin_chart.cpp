@@ -176,16 +176,17 @@ double LieGroupGalerkinDiscreteLagrangian::action(const double* q0, double h, bo
 // dexp_{sign w} is d(velocity)/d(xi_dot) of the chart curve at xi = -w (velocity = dexp_{-xi} xi_dot),
 // and its derivative in (sign w)_l is minus the mixed second derivative in (xi_l, xi_dot).
 void LieGroupGalerkinDiscreteLagrangian::dexp_with_derivatives(const double* q0, const double* w,
-                                                              double sign) {
+                                                              double sign, bool with_derivatives) {
   node_xi_ = -sign * Eigen::Map<const Eigen::VectorXd>(w, n_);
   node_rate_.setZero();
   check(manifold_.chart(q0, node_xi_.data(), node_rate_.data(), {},
-                        {nullptr, velocity_gradient_.data(), velocity_hessian_.data()}));
+                        {nullptr, velocity_gradient_.data(), with_derivatives ? velocity_hessian_.data() : nullptr}));
   const int V = 2 * n_;
   for (int k = 0; k < n_; ++k) {
     dexp_.row(k) = velocity_gradient_.segment(k * V + n_, n_).transpose();
-    for (int l = 0; l < n_; ++l)
-      for (int j = 0; j < n_; ++j) dexp_derivative_[l](k, j) = -velocity_hessian_[(k * V + l) * V + n_ + j];
+    if (with_derivatives)
+      for (int l = 0; l < n_; ++l)
+        for (int j = 0; j < n_; ++j) dexp_derivative_[l](k, j) = -velocity_hessian_[(k * V + l) * V + n_ + j];
   }
   dexp_lu_.compute(dexp_);
   dexp_inverse_T_ = dexp_lu_.inverse();
@@ -196,18 +197,19 @@ void LieGroupGalerkinDiscreteLagrangian::dexp_with_derivatives(const double* q0,
 // D1 L_d = tau - dexp_{xi^s}^{-T} sigma, whose derivative in xi^s also differentiates
 // dexp^{-T}: d(A^{-T} sigma)/dw_l = A^{-T} dsigma/dw_l - A^{-T} (dA/dw_l)^T A^{-T} sigma.
 // Evaluate (p0 null): unknowns xi^1..xi^{s-1}, equations dS/dxi^1..s-1.
-void LieGroupGalerkinDiscreteLagrangian::step_equations(const double* p0) {
+void LieGroupGalerkinDiscreteLagrangian::step_equations(const double* p0, bool with_jacobian) {
   const int n = n_, U = unknowns_;
   const int first_internal_row = p0 != nullptr ? 1 : 0;
   for (int nu = 1; nu < s_; ++nu) {
     const int row = (nu - 1 + first_internal_row) * n;
     residual_.segment(row, n) = gradient_.segment(nu * n, n);
-    jacobian_.block(row, 0, n, U * n) = hessian_.block(nu * n, n, n, U * n);
+    if (with_jacobian) jacobian_.block(row, 0, n, U * n) = hessian_.block(nu * n, n, n, U * n);
   }
   if (p0 == nullptr) return;
   const auto sigma = gradient_.segment(s_ * n, n);
   momentum_.noalias() = dexp_inverse_T_ * sigma;  // A^{-T} sigma
   residual_.head(n) = Eigen::Map<const Eigen::VectorXd>(p0, n) + gradient_.head(n) - momentum_;
+  if (!with_jacobian) return;
   jacobian_.topRows(n).noalias() = hessian_.block(0, n, n, U * n);
   jacobian_.topRows(n).noalias() -= dexp_inverse_T_ * hessian_.block(s_ * n, n, n, U * n);
   for (int l = 0; l < n; ++l)
@@ -217,19 +219,26 @@ void LieGroupGalerkinDiscreteLagrangian::step_equations(const double* p0) {
 
 // The step's equations [p0 + D1 L_d; dS/dxi^1..s-1] (evaluate: the internal ones) in the control
 // points xi^1..xi^unknowns, as a system for NewtonSolver (solve/newton.hpp), with the exact
-// Jacobian.
+// Jacobian, or (simplified) with the Jacobian at the first iterate kept for the whole solve
+// (simplified Newton, solve/newton.hpp): from the last step's curve continued, the iterate is
+// within O(h^{s+1}) of the solution, and the iteration contracts by about that much per update,
+// at a fraction of the cost of an update (no Hessians of the chart and the Lagrangian).
 struct LieGroupGalerkinDiscreteLagrangian::Equations {
   LieGroupGalerkinDiscreteLagrangian& g;
   const double* q0;
   const double* p0;
   double h;
+  bool simplified_newton = false;
+  int evaluations = 0;
 
   int size() const { return g.unknowns_ * g.n_; }
+  bool simplified() const { return simplified_newton; }
   // F's round-off yardstick: the largest of its terms p0 and dS/d(eta, xi).
   double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
-    g.action(q0, h);
-    if (p0 != nullptr) g.dexp_with_derivatives(q0, g.xi_.col(g.s_).data(), 1.0);
-    g.step_equations(p0);
+    const bool with_jacobian = !simplified_newton || evaluations++ == 0;
+    g.action(q0, h, with_jacobian);
+    if (p0 != nullptr) g.dexp_with_derivatives(q0, g.xi_.col(g.s_).data(), 1.0, with_jacobian);
+    g.step_equations(p0, with_jacobian);
     F = g.residual_.head(size());
     double yardstick = g.gradient_.lpNorm<Eigen::Infinity>();
     if (p0 != nullptr) yardstick = std::max(yardstick, Eigen::Map<const Eigen::VectorXd>(p0, g.n_).lpNorm<Eigen::Infinity>());
@@ -243,24 +252,31 @@ struct LieGroupGalerkinDiscreteLagrangian::Equations {
     return Eigen::Map<const Eigen::VectorXd>(q0, g.m_).lpNorm<Eigen::Infinity>() + g.xi_.lpNorm<Eigen::Infinity>();
   }
   // The gradient at the updated points, to first order from the Hessian at hand (the update is
-  // at round-off: the O(|update|^2) term is far below it), and the residual left, F - J update.
+  // at round-off: the O(|update|^2) term, and the Hessian's change since the first iterate times
+  // the update in simplified Newton, are far below it), and the residual left, F - J update.
   void finish(const Eigen::VectorXd& update) {
     g.gradient_.noalias() -= g.hessian_.middleCols(g.n_, size()) * update;
     g.residual_.head(size()).noalias() -= g.jacobian_.topLeftCorner(size(), size()) * update;
   }
 };
 
-void LieGroupGalerkinDiscreteLagrangian::newton(const double* q0, const double* p0, double h) {
-  Equations equations{*this, q0, p0, h};
-  require_converged(solver_.solve(equations, statistics_), "the Lie group Galerkin equations");
+void LieGroupGalerkinDiscreteLagrangian::newton(const double* q0, const double* p0, double h, bool simplified) {
+  Equations equations{*this, q0, p0, h, simplified};
+  SolveReport report = solver_.solve(equations, statistics_);
+  if (report.outcome == SolveReport::Outcome::not_contracting) {
+    equations.simplified_newton = false;
+    report = solver_.solve(equations, statistics_);
+  }
+  require_converged(report, "the Lie group Galerkin equations");
 }
 
 // The initial guess: the previous step's curve continued past its end (mapped into this step's
 // chart through the group) when this step follows it; otherwise xi(t) = t v0 with v0 from the
 // inverse Legendre transform of p0.
-void LieGroupGalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
+bool LieGroupGalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
   const Eigen::Map<const Eigen::VectorXd> start(q0, m_);
-  if (has_previous_ && previous_h_ == h && last_end_ == start) {
+  const bool continued = has_previous_ && previous_h_ == h && last_end_ == start;
+  if (continued) {
     for (int nu = 1; nu <= s_; ++nu) {
       node_xi_.noalias() = previous_ * extrapolation_.col(nu);
       check(manifold_.retract(previous_base_.data(), node_xi_.data(), q_.data()));
@@ -271,12 +287,15 @@ void LieGroupGalerkinDiscreteLagrangian::warm_start(const double* q0, const doub
     for (int nu = 1; nu <= s_; ++nu) xi_.col(nu) = basis_.control_times[nu] * h * v_;
   }
   xi_.col(0).setZero();
+  return continued;
 }
 
 // g1 = g0 exp(xi^s) and p1 = D2 L_d, each written as its start plus a small increment summed with
 // Kahan's compensation across steps (compensated.hpp) while each step continues from the last
 // one's output, so that a conserved momentum stays at round-off over long runs:
-//   g1 - g0 by point_increment();
+//   g1 - g0 by the group's own increment where it has one (Manifold::increment, formed to more
+//   than working precision: a rounding error that repeats along a steady motion adds up, and
+//   carries g off the group), else by point_increment();
 //   p1 - p0 = (D1 L_d + D2 L_d) - (p0 + D1 L_d) = tau + (dexp_{-xi}^{-T} - dexp_{xi}^{-T}) sigma - r0
 //           = tau + A(xi)^T sigma - r0,
 // r0 the residual left in the first equation. A(xi) = dexp_{-xi}^{-1} - dexp_{xi}^{-1} is linear in
@@ -290,15 +309,19 @@ void LieGroupGalerkinDiscreteLagrangian::take_step(const double* q0, const doubl
     carry_g_.setZero();
     carry_p_.setZero();
   }
-  warm_start(q0, p0, h);
+  const bool continued = warm_start(q0, p0, h);
   unknowns_ = s_;
-  newton(q0, p0, h);
+  newton(q0, p0, h, continued);
   if (dexp_slopes_.empty()) dexp_slopes(q0);
   const auto xi = xi_.col(s_);
   const auto sigma = gradient_.segment(s_ * n_, n_);
   momentum_change_ = gradient_.head(n_) - residual_.head(n_);
   for (int l = 0; l < n_; ++l) momentum_change_.noalias() += (2.0 * xi(l)) * (dexp_slopes_[l].transpose() * sigma);
-  const bool increment = point_increment(q0, xi);
+  bool increment = true;
+  if (manifold_.has_increment())
+    check(manifold_.increment(q0, xi.data(), point_change_.data()));
+  else
+    increment = point_increment(q0, xi);
   last_p_ = momentum;
   compensated_add(last_p_, momentum_change_, carry_p_);
   if (increment) {
@@ -319,7 +342,7 @@ void LieGroupGalerkinDiscreteLagrangian::take_step(const double* q0, const doubl
 // d dexp_w / dw_l at w = 0 (the Lie algebra's structure: dexp_w = I -/+ ad_w / 2 + O(w^2)).
 void LieGroupGalerkinDiscreteLagrangian::dexp_slopes(const double* q0) {
   const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n_);
-  dexp_with_derivatives(q0, zero.data(), 1.0);
+  dexp_with_derivatives(q0, zero.data(), 1.0, true);
   dexp_slopes_ = dexp_derivative_;
 }
 
@@ -358,17 +381,17 @@ void LieGroupGalerkinDiscreteLagrangian::evaluate(const double* q0, const double
   unknowns_ = s_ - 1;
   // Newton leaves the action and its gradient at the solution.
   if (unknowns_ > 0)
-    newton(q0, nullptr, h);
+    newton(q0, nullptr, h, false);
   else
     action(q0, h, false);
   const auto sigma = gradient_.segment(s_ * n_, n_);
   if (Ld != nullptr) *Ld = action_;
   if (D1 != nullptr) {
-    dexp_with_derivatives(q0, xi_.col(s_).data(), 1.0);
+    dexp_with_derivatives(q0, xi_.col(s_).data(), 1.0, false);
     Eigen::Map<Eigen::VectorXd>(D1, n_) = gradient_.head(n_) - dexp_inverse_T_ * sigma;
   }
   if (D2 != nullptr) {
-    dexp_with_derivatives(q0, xi_.col(s_).data(), -1.0);
+    dexp_with_derivatives(q0, xi_.col(s_).data(), -1.0, false);
     Eigen::Map<Eigen::VectorXd>(D2, n_) = dexp_inverse_T_ * sigma;
   }
 }

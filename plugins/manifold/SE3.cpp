@@ -81,6 +81,17 @@ class SE3 final : public varia::sdk::LieGroupManifold<RigidMotions> {
     return varia::sdk::groups::contains_rotation(q, why, why_size);
   }
 
+  // g0 exp(xi) - g0 = (R0 (exp(w) - I), R0 dexp_w rho) in extended precision, rounded once
+  // (varia/sdk/groups/so3.hpp, rotation_increment).
+  bool has_increment() const noexcept override { return true; }
+  varia::Status increment(const double* q0, const double* xi, double* dq) noexcept override {
+    using varia::sdk::groups::Extended;
+    const so3::Matrix3<Extended> R0 = varia::sdk::groups::rotation_increment(q0, xi, dq);
+    const so3::Vector3<Extended> w(xi[0], xi[1], xi[2]), rho(xi[3], xi[4], xi[5]);
+    Eigen::Map<Eigen::Vector3d>{dq + 9} = (R0 * (so3::dexp(w) * rho)).cast<double>();
+    return nullptr;
+  }
+
   bool has_constraint() const noexcept override { return true; }
   double constraint_error(const double* q) const noexcept override {
     return so3::orthogonality_error(so3::from_row_major(q));

@@ -181,6 +181,38 @@ TEST_CASE("lie group galerkin conserves spatial angular momentum and orthogonali
   CHECK(galerkin->solver_statistics().max_iterations <= 3);
 }
 
+// The point's increment g0 exp(xi) - g0 from the group in extended precision (Manifold::increment)
+// against the chart's quadrature in double: the quadrature's rounding, repeated along the steady
+// motion, carries R off SO(3) by about 2.5 eps |xi|^2 a step (|xi| = h |Omega| ~ 0.05 here), and
+// with it the spatial momentum R pi (docs/lie-groups.md, "Long runs").
+TEST_CASE("lie group galerkin: the group's increment keeps R on SO3 over a long run, the chart's quadrature does not") {
+  struct WithoutIncrement : Rotations {
+    bool has_increment() const noexcept override { return false; }
+  };
+  Problem p = free_body();
+  auto rule = gauss2();
+  const Vector3d pi0 = spatial_momentum(p.start);
+  const auto run = [&](Manifold& group, double& momentum) {
+    auto galerkin = make(group, p.top, rule, 2);
+    State y = p.start, next;
+    for (int k = 0; k < 20000; ++k) {
+      galerkin->step(y.data(), y.data() + 9, 0.05, next.data(), next.data() + 9);
+      y = next;
+    }
+    momentum = (spatial_momentum(y) - pi0).norm() / pi0.norm();
+    return so3::orthogonality_error(so3::from_row_major(y.data()));
+  };
+  Rotations own;
+  WithoutIncrement quadrature;
+  double momentum_own = 0.0, momentum_quadrature = 0.0;
+  const double own_error = run(own, momentum_own), quadrature_error = run(quadrature, momentum_quadrature);
+  MESSAGE("2*10^4 steps of h = 0.05: orthogonality " << own_error << " (the group's increment), " << quadrature_error
+                                                     << " (the quadrature); relative momentum error " << momentum_own
+                                                     << ", " << momentum_quadrature);
+  CHECK(own_error < 2e-15);
+  CHECK(quadrature_error > 1e-14);
+}
+
 TEST_CASE("lie group galerkin conserves the heavy top's vertical angular momentum at round-off") {
   Rotations group;
   Problem p = heavy_top();

@@ -66,13 +66,16 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   // Adds quadrature node i: L at the chart curve and the chain rule through the chart's jets.
   double add_node(const double* q0, int i, double h, bool with_hessian);
   // dexp_{sign w} (= d velocity / d xi_dot at xi = -sign w) into dexp_, its inverse transpose,
-  // and its derivatives in (sign w)_l (one n x n matrix each), from the manifold's chart at jets.
-  void dexp_with_derivatives(const double* q0, const double* w, double sign);
+  // and (with_derivatives) its derivatives in (sign w)_l (one n x n matrix each), from the
+  // manifold's chart at jets.
+  void dexp_with_derivatives(const double* q0, const double* w, double sign, bool with_derivatives);
   // The residual of the step's equations [p0 + D1 L_d; dS/dxi^1..s-1] (evaluate: internal only)
   // and its Jacobian in the unknowns.
-  void step_equations(const double* p0);
+  void step_equations(const double* p0, bool with_jacobian = true);
   struct Equations;  // those equations as a NewtonSolver system
-  void newton(const double* q0, const double* p0, double h);
+  // simplified: Newton's method with the Jacobian at the first iterate (Equations), falling back
+  // to the exact Jacobian when that does not contract.
+  void newton(const double* q0, const double* p0, double h, bool simplified);
   // The compensated final update (see step()): dexp's slopes at 0, and g0 exp(xi) - g0.
   void dexp_slopes(const double* q0);
   bool point_increment(const double* q0, const Eigen::Ref<const Eigen::VectorXd>& xi);
@@ -81,7 +84,8 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
     double bound;                    // the error constant E_k
   };
   static GaussRule gauss_legendre(int k);
-  void warm_start(const double* q0, const double* p0, double h);
+  // True when the guess continues the last step's curve (a guess within O(h^{s+1})).
+  bool warm_start(const double* q0, const double* p0, double h);
   void check(Status status) const;
 
   Manifold& manifold_;

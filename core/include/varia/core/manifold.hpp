@@ -59,6 +59,20 @@ class Manifold : public PluginObject {
   virtual Status local_derivatives(const double* /*q0*/, const double* /*q*/, Derivatives /*xi*/) noexcept {
     return "this manifold does not provide its natural chart's inverse to second order";
   }
+  // The step's increment of the point, q0 exp(xi) - q0 in the embedding, for the compensated
+  // update of the Lie group Galerkin construction (g1 = g0 + (g1 - g0) summed by Kahan's method,
+  // compensated.hpp). Formed as an increment, its rounding error is of the increment's size, not
+  // the point's; but an error of relative size eps that repeats from step to step (the same xi
+  // along a steady motion) still adds up over a long run, and what it carries off the group
+  // shows in every quantity that assumes the embedding's constraint: the orthogonality of R, and
+  // through it a momentum map evaluated at the point (docs/lie-groups.md, "Long runs"). A group
+  // that forms the increment to more than working precision (rounded to double once) declares
+  // has_increment(); otherwise the construction integrates the chart's derivative by a
+  // quadrature, to working precision.
+  virtual bool has_increment() const noexcept { return false; }
+  virtual Status increment(const double* /*q0*/, const double* /*xi*/, double* /*dq*/) noexcept {
+    return "this manifold does not provide its increment q0 exp(xi) - q0";
+  }
   // The group's action on its points at second-order jets (jet.hpp), for the Lie group one-step
   // methods and the shooting construction, which propagate (q, xi) with their derivatives
   // (paper, sec. 3 with sec. 2's Lie group methods): with n = dim(), m = point_size(),

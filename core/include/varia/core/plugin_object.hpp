@@ -15,8 +15,9 @@ namespace varia {
 // 2: Lagrangian::gradient_jet, OneStepMethod; 3: Manifold::constraint_error; 4: VectorField's
 // Lie group hooks (algebra, move); 5: Manifold::chart_jets, Manifold::local_jets; 6: the chart's
 // derivatives as caller-sized arrays (Manifold::chart, Manifold::local_derivatives, replacing the
-// jets), Manifold::has_constraint, Lagrangian::evaluates_at_jets, PluginObject::origin.
-inline constexpr int kAbiVersion = 7;
+// jets), Manifold::has_constraint, Lagrangian::evaluates_at_jets, PluginObject::origin;
+// 7: Manifold::translate, Manifold::generators; 9: Manifold::has_increment, Manifold::increment.
+inline constexpr int kAbiVersion = 9;
 
 using Status = const char*;
 

@@ -233,22 +233,63 @@ T orthogonality_error(const Matrix3<T>& R) {
   return (Matrix3<T>::Identity() - R.transpose() * R).norm();
 }
 
-// The value, first and second derivatives of the 3 x 3 matrix function M(w) from jets of it in
-// the 3 variables w: value, d[l] = dM/dw_l, dd[l][m] = d2M/dw_l dw_m.
+// The value, first and second derivatives of a 3 x 3 matrix function M(w): value, d[l] = dM/dw_l,
+// dd[l][m] = d2M/dw_l dw_m.
 struct MatrixJet3 {
   Matrix3<double> value, d[3], dd[3][3];
-  explicit MatrixJet3(const Matrix3<Jet2>& M) {
-    for (int r = 0; r < 3; ++r)
-      for (int c = 0; c < 3; ++c) {
-        const Jet2& x = M(r, c);
-        value(r, c) = x.value;
-        for (int l = 0; l < 3; ++l) {
-          d[l](r, c) = x.constant() ? 0.0 : x.gradient(l);
-          for (int m = 0; m < 3; ++m) dd[l][m](r, c) = x.constant() ? 0.0 : x.hessian(l, m);
-        }
-      }
+};
+
+// The value and first two derivatives of a coefficient function c(x) of x = theta^2, from c at a
+// jet in the one variable x.
+struct Coefficient {
+  double value, d1, d2;
+  template <class F>
+  static Coefficient at(double x, F&& c) {
+    const Jet2 y = c(Jet2::variable(x, 1, 0));
+    if (y.constant()) return {y.value, 0.0, 0.0};
+    return {y.value, y.gradient(0), y.hessian(0, 0)};
   }
 };
+
+// M(w) = I + a(x) W + b(x) W^2 (W = hat(w), x = |w|^2: exp, dexp and their inverses have this
+// form) with its derivatives in w, in doubles from a, b and their first two derivatives in x:
+// with dx/dw_l = 2 w_l, H_l = hat(e_l) = dW/dw_l and S_l = H_l W + W H_l = dW^2/dw_l (outer
+// products, from hat(a) hat(b) = b a^T - (a . b) I),
+//   dM/dw_l = a_l W + a H_l + b_l W^2 + b S_l,   a_l = 2 a' w_l,
+//   d2M/dw_l dw_m = a_lm W + a_l H_m + a_m H_l + b_lm W^2 + b_l S_m + b_m S_l + b (H_l H_m + H_m H_l),
+//   a_lm = 4 a'' w_l w_m + 2 a' delta_lm (b's alike).
+// A few hundred flops, where the same function at 3-variable jets costs thousands. Without
+// `second`, dd is left unset.
+template <class A, class B>
+MatrixJet3 quadratic_in_hat(const Vector3<double>& w, A&& a_of, B&& b_of, bool second = true) {
+  const double x = w.squaredNorm();
+  const Coefficient a = Coefficient::at(x, a_of), b = Coefficient::at(x, b_of);
+  const Matrix3<double> W = hat(w), W2 = W * W;
+  Matrix3<double> H[3], S[3];
+  double al[3], bl[3];
+  for (int l = 0; l < 3; ++l) {
+    H[l] = hat(Vector3<double>(Vector3<double>::Unit(l)));
+    S[l] = w * Vector3<double>::Unit(l).transpose() + Vector3<double>::Unit(l) * w.transpose();
+    S[l].diagonal().array() -= 2.0 * w(l);
+    al[l] = 2.0 * a.d1 * w(l);
+    bl[l] = 2.0 * b.d1 * w(l);
+  }
+  MatrixJet3 M;
+  M.value = Matrix3<double>::Identity() + a.value * W + b.value * W2;
+  for (int l = 0; l < 3; ++l) {
+    M.d[l] = al[l] * W + a.value * H[l] + bl[l] * W2 + b.value * S[l];
+    for (int m = 0; second && m <= l; ++m) {
+      const double alm = 4.0 * a.d2 * w(l) * w(m) + (l == m ? 2.0 * a.d1 : 0.0);
+      const double blm = 4.0 * b.d2 * w(l) * w(m) + (l == m ? 2.0 * b.d1 : 0.0);
+      M.dd[l][m] = alm * W + al[l] * H[m] + al[m] * H[l] + blm * W2 + bl[l] * S[m] + bl[m] * S[l];
+      M.dd[l][m](l, m) += b.value;  // b (H_l H_m + H_m H_l) = b (e_m e_l^T + e_l e_m^T - 2 delta_lm I)
+      M.dd[l][m](m, l) += b.value;
+      if (l == m) M.dd[l][m].diagonal().array() -= 2.0 * b.value;
+      M.dd[m][l] = M.dd[l][m];
+    }
+  }
+  return M;
+}
 
 // A jet in 6 variables with its value only; the caller fills gradient and Hessian.
 inline Jet2 jet6(double value) {
@@ -261,58 +302,60 @@ inline Jet2 jet6(double value) {
 // The natural chart at R0 to second order (the SO3 manifold's chart; paper, sec. 2 "Natural charts"):
 // R0 exp(eta) exp(xi) at eta = 0 as 9 row-major jets in the variables (eta, xi), and the
 // left-trivialized velocity dexp_{-xi}(xi_dot) as 3 jets in (xi, xi_dot). Either output may be
-// null.
-// Only exp(xi) and dexp_{-xi} are taken at jets, in the 3 variables xi; the rest is assembled from
-// their derivatives with double 3 x 3 products (jet arithmetic in all 6 variables did about 400
-// operations on 6 x 6 Hessians per call):
+// null; without point_second (velocity_second) that output's Hessians are left unset.
+// exp(xi) and dexp_{-xi} come with their derivatives in xi from quadratic_in_hat (in doubles; at
+// 3-variable jets they took most of a Lie group Galerkin step), and the rest is assembled from
+// them with double 3 x 3 products:
 //  - eta enters through exp(eta) = I + hat(eta) + hat(eta)^2/2 + O(|eta|^3), so with E = exp(xi),
 //    B = R0, H_k = hat(e_k): dR/deta_k = B H_k E, d2R/deta_k deta_l = B (H_k H_l + H_l H_k)/2 E,
 //    d2R/deta_k dxi_l = B H_k dE/dxi_l, and the xi derivatives are B's multiples of E's;
 //  - xi_dot enters linearly in Omega = D xi_dot, D = dexp_{-xi}: dOmega/dxi_dot_l = D e_l,
 //    d2Omega/dxi dxi_dot_l = dD/dxi e_l, d2Omega/dxi_dot^2 = 0.
-inline void chart_jets(const double* R0, const double* xi, const double* xi_dot, Jet2* point, Jet2* velocity) {
-  Vector3<Jet2> w;
-  for (int k = 0; k < 3; ++k) w(k) = Jet2::variable(xi[k], 3, k);
+inline void chart_jets(const double* R0, const double* xi, const double* xi_dot, Jet2* point, Jet2* velocity,
+                       bool point_second = true, bool velocity_second = true) {
+  const Vector3<double> w(xi[0], xi[1], xi[2]);
   if (point != nullptr) {
-    const MatrixJet3 E(exp(w));
+    const MatrixJet3 E = quadratic_in_hat(
+        w, [](const Jet2& x) { return sinc(x); }, [](const Jet2& x) { return cosc(x); }, point_second);
     const Matrix3<double> B = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R0);
-    Matrix3<double> H[3], BH[3];  // H_k = hat(e_k), B H_k
-    for (int k = 0; k < 3; ++k) {
-      H[k] = hat(Vector3<double>(Vector3<double>::Unit(k)));
-      BH[k] = B * H[k];
-    }
+    const Matrix3<double> R = B * E.value;
+    Matrix3<double> BH[3];  // B H_k, H_k = hat(e_k)
+    for (int k = 0; k < 3; ++k) BH[k] = B * hat(Vector3<double>(Vector3<double>::Unit(k)));
     Matrix3<double> by[6], by2[6][6];  // the derivatives in the 6 variables (eta, xi)
     for (int k = 0; k < 3; ++k) {
       by[k] = BH[k] * E.value;
       by[3 + k] = B * E.d[k];
-      for (int l = 0; l < 3; ++l) {
-        by2[k][l] = (BH[k] * H[l] + BH[l] * H[k]) * E.value / 2.0;
+      for (int l = 0; point_second && l < 3; ++l) {
+        // B (H_k H_l + H_l H_k)/2 E with H_k H_l = e_l e_k^T - delta_kl I: outer products.
+        by2[k][l] = (B.col(l) * E.value.row(k) + B.col(k) * E.value.row(l)) / 2.0;
+        if (k == l) by2[k][l] -= R;
         by2[k][3 + l] = BH[k] * E.d[l];
         by2[3 + l][k] = by2[k][3 + l];
         by2[3 + k][3 + l] = B * E.dd[k][l];
       }
     }
-    const Matrix3<double> R = B * E.value;
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) {
         Jet2& jet = point[3 * r + c] = jet6(R(r, c));
         for (int a = 0; a < 6; ++a) {
           jet.gradient(a) = by[a](r, c);
-          for (int b = 0; b < 6; ++b) jet.hessian(a, b) = by2[a][b](r, c);
+          for (int b = 0; point_second && b < 6; ++b) jet.hessian(a, b) = by2[a][b](r, c);
         }
       }
   }
   if (velocity != nullptr) {
-    const MatrixJet3 D(dexp(Vector3<Jet2>(-w)));
+    // dexp_{-xi} = I - cosc hat(xi) + sinc3 hat(xi)^2.
+    const MatrixJet3 D = quadratic_in_hat(
+        w, [](const Jet2& x) { return -cosc(x); }, [](const Jet2& x) { return sinc3(x); }, velocity_second);
     const Eigen::Map<const Vector3<double>> rate(xi_dot);
     const Vector3<double> omega = D.value * rate;
     for (int i = 0; i < 3; ++i) {
       Jet2& jet = velocity[i] = jet6(omega(i));
-      jet.hessian.setZero();
+      if (velocity_second) jet.hessian.setZero();
       for (int k = 0; k < 3; ++k) {
         jet.gradient(k) = D.d[k].row(i).dot(rate);
         jet.gradient(3 + k) = D.value(i, k);
-        for (int m = 0; m < 3; ++m) {
+        for (int m = 0; velocity_second && m < 3; ++m) {
           jet.hessian(k, m) = D.dd[k][m].row(i).dot(rate);
           jet.hessian(k, 3 + m) = jet.hessian(3 + m, k) = D.d[k](i, m);
         }

@@ -7,6 +7,7 @@
 #include <Eigen/LU>
 #include <array>
 #include <cmath>
+#include <limits>
 
 #include "varia/core/so3.hpp"
 #include "varia/sdk/lie_group.hpp"
@@ -35,6 +36,23 @@ inline bool contains_rotation(const double* q, char* why, int why_size) {
   if (std::abs(R.determinant() - 1.0) > kMembershipTolerance)
     return explain(why, why_size, "R is a reflection, not a rotation: det R = %.17g", R.determinant());
   return true;
+}
+
+// The extended precision of the increments below: the x87 format's 64-bit significand on
+// x86-64, IEEE quadruple precision (113 bits) on AArch64 Linux.
+using Extended = long double;
+static_assert(std::numeric_limits<Extended>::digits > std::numeric_limits<double>::digits,
+              "the group increments need a long double wider than double");
+
+// R0 (exp(w) - I) (Manifold::increment of SO(3), and of SE(3)'s rotation), by Rodrigues' formula
+// for exp(w) - I (so3::expm1) in Extended and rounded to double once: its rounding error is then
+// a fraction eps of the increment that does not repeat along a steady motion, where the same
+// increment in double carried R off SO(3) by about 2.5 eps |w|^2 a step (docs/lie-groups.md).
+inline so3::Matrix3<Extended> rotation_increment(const double* R0, const double* w, double* dR) {
+  const so3::Matrix3<Extended> B = from_row_major(R0).cast<Extended>();
+  const so3::Matrix3<Extended> increment = B * so3::expm1(so3::Vector3<Extended>(w[0], w[1], w[2]));
+  Eigen::Map<RowMajor<double>>{dR} = increment.cast<double>();
+  return B;
 }
 
 // The minimal API of SO(3) (varia/sdk/lie_group.hpp): R row-major, the algebra R^3 with the
@@ -85,10 +103,16 @@ class RotationGroup : public LieGroupManifold<Rotations> {
     const bool with_point = point.value != nullptr || point.gradient != nullptr || point.hessian != nullptr;
     const bool with_velocity =
         velocity.value != nullptr || velocity.gradient != nullptr || velocity.hessian != nullptr;
-    so3::chart_jets(q0, xi, xi_dot, with_point ? point_.data() : nullptr,
-                    with_velocity ? velocity_.data() : nullptr);
+    so3::chart_jets(q0, xi, xi_dot, with_point ? point_.data() : nullptr, with_velocity ? velocity_.data() : nullptr,
+                    point.hessian != nullptr, velocity.hessian != nullptr);
     if (with_point) store(point_.data(), 9, 6, point);
     if (with_velocity) store(velocity_.data(), 3, 6, velocity);
+    return nullptr;
+  }
+
+  bool has_increment() const noexcept override { return true; }
+  Status increment(const double* q0, const double* xi, double* dq) noexcept override {
+    rotation_increment(q0, xi, dq);
     return nullptr;
   }
 
