@@ -188,7 +188,6 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
   const Eigen::FullPivLU<Eigen::MatrixXd> block(stiffness_.block(0, 1, s_, s_));
   if (!block.isInvertible()) return false;
   stiffness_inverse_ = block.inverse();
-  restart_.resize(n_, s_ + 1);
   const int r = static_cast<int>(nodes_.size());
   node_forces_ = Eigen::MatrixXd::Zero(n_, r);
   previous_forces_ = node_forces_;
@@ -658,9 +657,8 @@ void GalerkinDiscreteLagrangian::factorize_sparse() {
 void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
                                         int blocks, const double* p0, bool forced) {
   if (simplified_solve_ != nullptr && p0 != nullptr) {
-    restart_ = points_;
     if ((this->*simplified_solve_)(h, p0)) return;
-    points_ = restart_;
+    warm_start(origin_.data(), p0, h);  // the same warm start again (q0 = origin_)
   }
   if (lagrangian_.sparse()) prepare_sparse(first_unknown, first_equation, blocks);
   const int size = blocks * n_;
@@ -732,8 +730,10 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   compensated_add(end_p_, impulse_, carry_p_);
   end = previous_end_;
   momentum1 = end_p_;
-  previous_ = points_;
-  if (predict_ != nullptr) previous_forces_ = node_forces_;
+  if (predict_ != nullptr)
+    previous_forces_ = node_forces_;
+  else
+    previous_ = points_;
   previous_h_ = h;
   has_previous_ = true;
 }

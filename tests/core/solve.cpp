@@ -117,3 +117,20 @@ TEST_CASE("equations without a root diverge to the iteration limit, a non-finite
   CHECK_THROWS_WITH_AS(require_converged(report, "the cubic"), "the cubic have a non-finite residual",
                        NumericalFailure);
 }
+
+// The solver's |x|_inf (a plain loop, not Eigen's lpNorm): the largest magnitude, infinite when an
+// entry is, and NaN when any entry is NaN, wherever it stands (a NaN that the loop's maximum would
+// pass over is carried by the sum), so that the solve reports the residual as non-finite.
+TEST_CASE("the solver's max norm: the largest magnitude, NaN when any entry is NaN") {
+  const double nan = std::numeric_limits<double>::quiet_NaN(), inf = std::numeric_limits<double>::infinity();
+  CHECK(max_norm(Eigen::VectorXd::Zero(0)) == 0.0);
+  CHECK(max_norm(Eigen::Vector3d(-3.0, 2.0, 0.5)) == 3.0);
+  CHECK(max_norm(Eigen::Vector2d(1.0, -inf)) == inf);
+  for (int at = 0; at < 3; ++at) {
+    Eigen::VectorXd x = Eigen::Vector3d(1.0, -4.0, 0.5);
+    CHECK_FALSE(std::isnan(max_norm(x)));
+    x[at] = nan;
+    CAPTURE(at);
+    CHECK(std::isnan(max_norm(x)));
+  }
+}

@@ -161,7 +161,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // eps |v|, not eps |q|/h, which would random-walk the momentum (docs/hard-cases.md, Kepler).
   Eigen::VectorXd origin_;
   Eigen::MatrixXd points_;    // n x (s+1), offsets of the control points as columns
-  Eigen::MatrixXd previous_;  // the last step's offsets
+  Eigen::MatrixXd previous_;  // the last step's offsets (kept where predict() does not apply)
   Eigen::VectorXd previous_end_;  // the last step's q1
   double previous_h_ = 0.0;
   bool has_previous_ = false;
@@ -198,8 +198,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // from there: one gradient evaluation per step).
   AdvanceFunction explicit_advance_ = nullptr;
   // Simplified Newton (constant mass matrix): the stiffness matrix K ((s+1) x (s+1)), the inverse
-  // of its block K(0..s-1, 1..s), M^{-1} (inverse_mass_), and a copy of the step's unknowns to
-  // solve again from with the exact Jacobian. Its warm start (predict()): the forces dL/dq at the
+  // of its block K(0..s-1, 1..s), and M^{-1} (inverse_mass_). Its warm start (predict()): the forces dL/dq at the
   // nodes of the last evaluation (node_forces_, n x r) and of the last step (previous_forces_),
   // and force_prediction_ (r x s): the extrapolation of the nodes' forces to the next step's
   // nodes (l_i(1 + c_j), the Lagrange basis through the nodes) times the weights b_j l_nu(c_j) of
@@ -207,7 +206,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // products of the kinetic part ((s+1) n).
   SimplifiedFunction simplified_solve_ = nullptr;
   PredictFunction predict_ = nullptr;
-  Eigen::MatrixXd stiffness_, stiffness_inverse_, restart_;
+  Eigen::MatrixXd stiffness_, stiffness_inverse_;
   Eigen::MatrixXd node_forces_, previous_forces_, force_prediction_;
   Eigen::VectorXd predicted_, kinetic_;
   double b0_ = 0.0, b1_ = 0.0;

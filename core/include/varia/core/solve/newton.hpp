@@ -131,6 +131,20 @@ inline void require_converged(const SolveReport& report, const char* equations) 
                          report.residual);
 }
 
+// |x|_inf by a plain loop, NaN if an entry is. The systems store F and the update entry by entry
+// just before the solver measures them, and a vectorized load of two entries waits for both
+// stores (the store cannot be forwarded): with Eigen's lpNorm that stall was a third of the
+// solver's own time in a 2-unknown solve (issue #19). Branch-free: the sum carries a NaN.
+inline double max_norm(const Eigen::VectorXd& x) {
+  double largest = 0.0, sum = 0.0;
+  for (Eigen::Index k = 0; k < x.size(); ++k) {
+    const double a = std::abs(x[k]);
+    largest = std::max(largest, a);
+    sum += a;
+  }
+  return std::isnan(sum) ? sum : largest;
+}
+
 // factorize() and solve() of a system with a dense Jacobian, held in `jacobian` (n x n), which
 // the system fills in evaluate(); sized once.
 class DenseLinearization {
@@ -177,7 +191,7 @@ class NewtonSolver {
     SolveReport report;
     for (int k = 0;; ++k) {
       const double yardstick = system.evaluate(F_);
-      const double r = F_.template lpNorm<Eigen::Infinity>();
+      const double r = max_norm(F_);
       const bool decreasing = k == 0 || r <= 0.5 * residuals_.back();
       residuals_.push_back(r);
       report.residual = r;
@@ -192,7 +206,7 @@ class NewtonSolver {
       // O(last update x this update).
       if (k == 0 || (!at_round_off && !simplified)) system.factorize();
       system.solve(F_, update_);
-      const double size_of_update = update_.template lpNorm<Eigen::Infinity>();
+      const double size_of_update = max_norm(update_);
       const double x_yardstick = system.apply(update_);
       report.iterations = k + 1;
       const bool stagnating = !decreasing && size_of_update <= std::sqrt(options_.tolerance) * (1.0 + x_yardstick);
