@@ -120,6 +120,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   std::vector<Eigen::MatrixXd> dexp_derivative_;     // d dexp_w / dw_l
   Eigen::PartialPivLU<Eigen::MatrixXd> dexp_lu_, lu_;
   Eigen::VectorXd residual_, momentum_;
+  Eigen::VectorXd refined_residual_, refined_update_;  // simplified Newton's last update (Equations::finish)
   Eigen::MatrixXd jacobian_;
   int unknowns_ = 0;  // the leading control points solved for: s (step) or s - 1 (evaluate)
 };
