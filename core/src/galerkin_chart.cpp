@@ -101,6 +101,7 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
   carry_p_ = Eigen::VectorXd::Zero(n_);
   last_p_.resize(n_);
   point_change_.resize(m_);
+  point_change_low_.resize(m_);
   momentum_change_.resize(n_);
   for (int k = 1; k <= kMaxIncrementNodes; ++k) increment_rules_.push_back(gauss_legendre(k));
 }
@@ -307,8 +308,9 @@ bool LieGroupGalerkinDiscreteLagrangian::warm_start(const double* q0, const doub
 // Kahan's compensation across steps (compensated.hpp) while each step continues from the last
 // one's output, so that a conserved momentum stays at round-off over long runs:
 //   g1 - g0 by the group's own increment where it has one (Manifold::increment, formed to more
-//   than working precision: a rounding error that repeats along a steady motion adds up, and
-//   carries g off the group), else by point_increment();
+//   than working precision, its part below double's taken into the compensation: a rounding
+//   error that repeats along a steady motion adds up, and carries g off the group), else by
+//   point_increment();
 //   p1 - p0 = (D1 L_d + D2 L_d) - (p0 + D1 L_d) = tau + (dexp_{-xi}^{-T} - dexp_{xi}^{-T}) sigma - r0
 //           = tau + A(xi)^T sigma - r0,
 // r0 the residual left in the first equation. A(xi) = dexp_{-xi}^{-1} - dexp_{xi}^{-1} is linear in
@@ -331,8 +333,9 @@ void LieGroupGalerkinDiscreteLagrangian::take_step(const double* q0, const doubl
   momentum_change_ = gradient_.head(n_) - residual_.head(n_);
   for (int l = 0; l < n_; ++l) momentum_change_.noalias() += (2.0 * xi(l)) * (dexp_slopes_[l].transpose() * sigma);
   bool increment = true;
+  point_change_low_.setZero();
   if (manifold_.has_increment())
-    check(manifold_.increment(q0, xi.data(), point_change_.data()));
+    check(manifold_.increment(q0, xi.data(), point_change_.data(), point_change_low_.data()));
   else
     increment = point_increment(q0, xi);
   last_p_ = momentum;
@@ -340,6 +343,7 @@ void LieGroupGalerkinDiscreteLagrangian::take_step(const double* q0, const doubl
   if (increment) {
     last_end_ = start;
     compensated_add(last_end_, point_change_, carry_g_);
+    carry_g_ -= point_change_low_;  // the sum is last_end_ - carry_g_ (compensated.hpp)
   } else {
     check(manifold_.retract(q0, xi.data(), last_end_.data()));
     carry_g_.setZero();

@@ -81,14 +81,14 @@ class SE3 final : public varia::sdk::LieGroupManifold<RigidMotions> {
     return varia::sdk::groups::contains_rotation(q, why, why_size);
   }
 
-  // g0 exp(xi) - g0 = (R0 (exp(w) - I), R0 dexp_w rho) in extended precision, rounded once
-  // (varia/sdk/groups/so3.hpp, rotation_increment).
+  // g0 exp(xi) - g0 = (R0 (exp(w) - I), R0 dexp_w rho) in extended precision, as its double
+  // part and the rest (varia/sdk/groups/so3.hpp, rotation_increment).
   bool has_increment() const noexcept override { return true; }
-  varia::Status increment(const double* q0, const double* xi, double* dq) noexcept override {
+  varia::Status increment(const double* q0, const double* xi, double* dq, double* dq_low) noexcept override {
     using varia::sdk::groups::Extended;
-    const so3::Matrix3<Extended> R0 = varia::sdk::groups::rotation_increment(q0, xi, dq);
+    const so3::Matrix3<Extended> R0 = varia::sdk::groups::rotation_increment(q0, xi, dq, dq_low);
     const so3::Vector3<Extended> w(xi[0], xi[1], xi[2]), rho(xi[3], xi[4], xi[5]);
-    Eigen::Map<Eigen::Vector3d>{dq + 9} = (R0 * (so3::dexp(w) * rho)).cast<double>();
+    varia::sdk::groups::split<3, 1>(so3::Vector3<Extended>(R0 * (so3::dexp(w) * rho)), dq + 9, dq_low + 9);
     return nullptr;
   }
 

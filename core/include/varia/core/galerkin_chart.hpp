@@ -104,7 +104,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   Eigen::VectorXd previous_base_, last_end_, last_p_;  // the last step's g0, g1 and p1
   // Compensated sums g1 = g0 + (g1 - g0), p1 = p0 + (p1 - p0) across steps (compensated.hpp):
   // the running compensations and the increments.
-  Eigen::VectorXd carry_g_, carry_p_, point_change_, momentum_change_;
+  Eigen::VectorXd carry_g_, carry_p_, point_change_, point_change_low_, momentum_change_;
   std::vector<Eigen::MatrixXd> dexp_slopes_;  // d dexp_w / dw_l at w = 0, once
   std::vector<GaussRule> increment_rules_;    // k = 1 .. 10 nodes
   double previous_h_ = 0.0;

@@ -66,11 +66,13 @@ class Manifold : public PluginObject {
   // along a steady motion) still adds up over a long run, and what it carries off the group
   // shows in every quantity that assumes the embedding's constraint: the orthogonality of R, and
   // through it a momentum map evaluated at the point (docs/lie-groups.md, "Long runs"). A group
-  // that forms the increment to more than working precision (rounded to double once) declares
-  // has_increment(); otherwise the construction integrates the chart's derivative by a
-  // quadrature, to working precision.
+  // that forms the increment to more than working precision declares has_increment() and gives
+  // it as dq + dq_low (point_size() numbers each): dq rounded to double, dq_low the rest, which
+  // the compensated sum takes in too (a rounding of the increment to double at every step would
+  // still walk randomly, eps/2 |xi| a step). Otherwise the construction integrates the chart's
+  // derivative by a quadrature, to working precision.
   virtual bool has_increment() const noexcept { return false; }
-  virtual Status increment(const double* /*q0*/, const double* /*xi*/, double* /*dq*/) noexcept {
+  virtual Status increment(const double* /*q0*/, const double* /*xi*/, double* /*dq*/, double* /*dq_low*/) noexcept {
     return "this manifold does not provide its increment q0 exp(xi) - q0";
   }
   // The group's action on its points at second-order jets (jet.hpp), for the Lie group one-step

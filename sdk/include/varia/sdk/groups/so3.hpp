@@ -44,14 +44,24 @@ using Extended = long double;
 static_assert(std::numeric_limits<Extended>::digits > std::numeric_limits<double>::digits,
               "the group increments need a long double wider than double");
 
+// An Extended increment as its double part and the rest (Manifold::increment's dq, dq_low).
+template <int Rows, int Columns>
+void split(const Eigen::Matrix<Extended, Rows, Columns>& increment, double* high, double* low) {
+  for (int r = 0; r < Rows; ++r)
+    for (int c = 0; c < Columns; ++c) {
+      const double h = static_cast<double>(increment(r, c));
+      high[Columns * r + c] = h;
+      low[Columns * r + c] = static_cast<double>(increment(r, c) - h);
+    }
+}
+
 // R0 (exp(w) - I) (Manifold::increment of SO(3), and of SE(3)'s rotation), by Rodrigues' formula
-// for exp(w) - I (so3::expm1) in Extended and rounded to double once: its rounding error is then
-// a fraction eps of the increment that does not repeat along a steady motion, where the same
-// increment in double carried R off SO(3) by about 2.5 eps |w|^2 a step (docs/lie-groups.md).
-inline so3::Matrix3<Extended> rotation_increment(const double* R0, const double* w, double* dR) {
+// for exp(w) - I (so3::expm1) in Extended, as its double part and the rest: the same increment in
+// double, rounded at every step with an error that repeats along a steady motion, carried R off
+// SO(3) by about 2.5 eps |w|^2 a step (docs/lie-groups.md, "Long runs"). Returns R0 in Extended.
+inline so3::Matrix3<Extended> rotation_increment(const double* R0, const double* w, double* dR, double* dR_low) {
   const so3::Matrix3<Extended> B = from_row_major(R0).cast<Extended>();
-  const so3::Matrix3<Extended> increment = B * so3::expm1(so3::Vector3<Extended>(w[0], w[1], w[2]));
-  Eigen::Map<RowMajor<double>>{dR} = increment.cast<double>();
+  split<3, 3>(B * so3::expm1(so3::Vector3<Extended>(w[0], w[1], w[2])), dR, dR_low);
   return B;
 }
 
@@ -111,8 +121,8 @@ class RotationGroup : public LieGroupManifold<Rotations> {
   }
 
   bool has_increment() const noexcept override { return true; }
-  Status increment(const double* q0, const double* xi, double* dq) noexcept override {
-    rotation_increment(q0, xi, dq);
+  Status increment(const double* q0, const double* xi, double* dq, double* dq_low) noexcept override {
+    rotation_increment(q0, xi, dq, dq_low);
     return nullptr;
   }
 
