@@ -89,6 +89,8 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
   hessian_.resize(size, size);
   dexp_.resize(n_, n_);
   dexp_inverse_T_.resize(n_, n_);
+  identity_ = Eigen::MatrixXd::Identity(n_, n_);
+  dexp_momentum_.resize(n_);
   dexp_derivative_.assign(n_, Eigen::MatrixXd(n_, n_));
   dexp_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
   lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_ * s_);
@@ -117,7 +119,8 @@ void LieGroupGalerkinDiscreteLagrangian::check(Status status) const {
 // xi_dot = sum_nu l'_nu(c_i) xi^nu / h (paper, sec. 2: the interpolant in the Lie algebra).
 double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, double h, bool with_hessian) {
   node_xi_.noalias() = xi_ * basis_.phi.col(i);
-  node_rate_.noalias() = xi_ * basis_.dphi.col(i) / h;
+  node_rate_.noalias() = xi_ * basis_.dphi.col(i);  // a product over h would build a temporary
+  node_rate_ /= h;
   const int n = n_;
   const Derivatives point = reduced_ ? Derivatives{} : Derivatives{point_.data(), point_gradient_.data(),
                                                                    with_hessian ? point_hessian_.data() : nullptr};
@@ -192,7 +195,7 @@ void LieGroupGalerkinDiscreteLagrangian::dexp_with_derivatives(const double* q0,
         for (int j = 0; j < n_; ++j) dexp_derivative_[l](k, j) = -velocity_hessian_[(k * V + l) * V + n_ + j];
   }
   dexp_lu_.compute(dexp_);
-  dexp_inverse_T_ = dexp_lu_.inverse();
+  dexp_inverse_T_.noalias() = dexp_lu_.solve(identity_);  // not inverse(): it allocates a temporary
   dexp_inverse_T_.transposeInPlace();
 }
 
@@ -215,9 +218,10 @@ void LieGroupGalerkinDiscreteLagrangian::step_equations(const double* p0, bool w
   if (!with_jacobian) return;
   jacobian_.topRows(n).noalias() = hessian_.block(0, n, n, U * n);
   jacobian_.topRows(n).noalias() -= dexp_inverse_T_ * hessian_.block(s_ * n, n, n, U * n);
-  for (int l = 0; l < n; ++l)
-    jacobian_.block(0, (s_ - 1) * n + l, n, 1).noalias() +=
-        dexp_inverse_T_ * (dexp_derivative_[l].transpose() * momentum_);
+  for (int l = 0; l < n; ++l) {
+    dexp_momentum_.noalias() = dexp_derivative_[l].transpose() * momentum_;
+    jacobian_.block(0, (s_ - 1) * n + l, n, 1).noalias() += dexp_inverse_T_ * dexp_momentum_;
+  }
 }
 
 // The step's equations [p0 + D1 L_d; dS/dxi^1..s-1] (evaluate: the internal ones) in the control

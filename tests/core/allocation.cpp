@@ -9,6 +9,8 @@
 
 #include "core/fixtures.hpp"
 #include "varia/core/galerkin.hpp"
+#include "varia/core/galerkin_chart.hpp"
+#include "varia/sdk/groups/so3.hpp"
 
 extern "C" void* __libc_malloc(std::size_t size);  // glibc's own malloc, always exported
 extern "C" void* __libc_calloc(std::size_t count, std::size_t size);
@@ -88,4 +90,31 @@ TEST_CASE("galerkin steps allocate nothing: explicit form, simplified Newton and
     CHECK(allocations_of_steps(galerkin, n) == 0);
     CHECK(galerkin.evaluations().hessian > 100);
   }
+}
+
+// SO(3) through the SDK's generic adapter (no tuned chart): each simplified Newton iteration asks
+// the chart for first derivatives only, at first-order duals on the stack.
+class AdapterRotations final : public sdk::LieGroupManifold<sdk::groups::Rotations> {
+ public:
+  bool contains(const double*, char*, int) noexcept override { return true; }
+};
+
+TEST_CASE("lie group galerkin steps allocate nothing through the sdk's generic chart (first-order duals)") {
+  AdapterRotations group;
+  Top top(Eigen::Vector3d(1, 2, 3), 1.0, Eigen::Vector3d(0, 0, 0.5));
+  auto rule = lobatto3();
+  LieGroupGalerkinDiscreteLagrangian map(group, top, rule, equispaced_control_times(2), {});
+  Eigen::VectorXd R(9), p(3), R1(9), p1(3);
+  R << 1, 0, 0, 0, 1, 0, 0, 0, 1;
+  p << 0.4, 1.6, -1.8;
+  map.step(R.data(), p.data(), 0.05, R1.data(), p1.data());
+  const long count = allocations_of([&] {
+    for (int k = 0; k < 50; ++k) {
+      map.step(R1.data(), p1.data(), 0.05, R.data(), p.data());
+      R.swap(R1);
+      p.swap(p1);
+    }
+  });
+  CHECK(count == 0);
+  CHECK(map.solver_statistics().iterations > 100);
 }

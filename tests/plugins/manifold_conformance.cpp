@@ -1,6 +1,7 @@
 // The Lie group manifold conformance suite (varia/sdk/conformance/manifold.hpp) on the bundled
-// groups, at random points, and on a group that breaks the SDK adapter's hypothesis (a
-// composition that is not affine in its second factor), which it must refuse.
+// groups, at random points, on a group that breaks the SDK adapter's hypothesis (a composition
+// that is not affine in its second factor), and on a chart whose first derivatives asked alone
+// are wrong: the suite must refuse both.
 #include <doctest/doctest.h>
 
 #include <random>
@@ -56,6 +57,40 @@ class CubicLine final : public varia::sdk::LieGroupManifold<Cubic> {
   bool contains(const double* q, char*, int) noexcept override { return std::abs(q[1] - q[0] * q[0] * q[0]) < 1e-12; }
 };
 
+// R under addition, a group the suite passes, whose chart then lies about its gradient away from
+// 0 when asked without the Hessian (a hand-written first-order path that went wrong).
+struct Line {
+  static constexpr int point_size = 1, dim = 1;
+  template <class T>
+  static void compose(const T* a, const T* b, T* ab) {
+    ab[0] = a[0] + b[0];
+  }
+  static void inverse(const double* a, double* a_inverse) { a_inverse[0] = -a[0]; }
+  template <class T>
+  static void exp(const T* xi, T* g) {
+    g[0] = xi[0];
+  }
+  template <class T>
+  static void log(const T* g, T* xi) {
+    xi[0] = g[0];
+  }
+  template <class T>
+  static void bracket(const T*, const T*, T* ab) {
+    ab[0] = T(0.0);
+  }
+};
+
+class LyingLine final : public varia::sdk::LieGroupManifold<Line> {
+ public:
+  bool contains(const double*, char*, int) noexcept override { return true; }
+  varia::Status chart(const double* q0, const double* xi, const double* xi_dot, varia::Derivatives point,
+                      varia::Derivatives velocity) noexcept override {
+    varia::Status status = LieGroupManifold::chart(q0, xi, xi_dot, point, velocity);
+    if (xi[0] != 0.0 && point.hessian == nullptr && point.gradient != nullptr) point.gradient[1] *= 1.5;
+    return status;
+  }
+};
+
 }  // namespace
 
 TEST_CASE("the Lie group conformance suite passes SO3 and SE3 at random points, with the generators' Taylor test") {
@@ -83,4 +118,21 @@ TEST_CASE("the Lie group conformance suite refuses a group whose composition is 
   bool names_generators = false;
   for (const auto& failure : failures.list()) names_generators |= failure.find("generators") != std::string::npos;
   CHECK(names_generators);
+}
+
+TEST_CASE("the Lie group conformance suite refuses a chart whose gradient without the Hessian is not the one with it") {
+  std::mt19937 engine(11);
+  LyingLine line;
+  const Eigen::VectorXd q = Eigen::VectorXd::Constant(1, 0.4);
+  const auto failures = varia::sdk::conformance::check_lie_group(line, q, engine);
+  REQUIRE_FALSE(failures.empty());
+  bool names_chart = false;
+  for (const auto& failure : failures.list()) names_chart |= failure.find("without the Hessian") != std::string::npos;
+  CHECK(names_chart);
+  // The same group without the lie passes.
+  class HonestLine final : public varia::sdk::LieGroupManifold<Line> {
+   public:
+    bool contains(const double*, char*, int) noexcept override { return true; }
+  } honest;
+  CHECK(varia::sdk::conformance::check_lie_group(honest, q, engine).empty());
 }

@@ -116,10 +116,10 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   double action_ = 0.0;        // S at the last evaluation
   Eigen::VectorXd gradient_;  // n (s+1)
   Eigen::MatrixXd hessian_;   // n (s+1) square
-  Eigen::MatrixXd dexp_, dexp_inverse_T_;            // dexp_{w}, dexp_w^{-T}
+  Eigen::MatrixXd dexp_, dexp_inverse_T_, identity_;  // dexp_{w}, dexp_w^{-T}, I
   std::vector<Eigen::MatrixXd> dexp_derivative_;     // d dexp_w / dw_l
   Eigen::PartialPivLU<Eigen::MatrixXd> dexp_lu_, lu_;
-  Eigen::VectorXd residual_, momentum_;
+  Eigen::VectorXd residual_, momentum_, dexp_momentum_;  // momentum_ = A^{-T} sigma; (dA/dw_l)^T momentum_
   Eigen::VectorXd refined_residual_, refined_update_;  // simplified Newton's last update (Equations::finish)
   Eigen::MatrixXd jacobian_;
   int unknowns_ = 0;  // the leading control points solved for: s (step) or s - 1 (evaluate)

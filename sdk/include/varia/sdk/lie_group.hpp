@@ -22,13 +22,17 @@
 //   product written (R, x) (SE(3): (R1 R2, x1 + R1 x2)). The Lie group conformance suite
 //   (varia/sdk/conformance/manifold.hpp) checks D(q) against retract by a Taylor test, so a group
 //   for which this fails is refused there.
-// Derivatives come from the templated operations evaluated at second-order jets (Jet2). A jet
+// Derivatives come from the templated operations evaluated at second-order jets (Jet2), and the
+// chart's (exp, compose, bracket) at first-order dual numbers (Eigen::AutoDiffScalar,
+// differentiate_first_order) when no Hessian is asked: those operations must compile at both
+// scalars. (Not log: Eigen's atan2 of an AutoDiffScalar allocates.) A jet
 // holds at most kMaxJetVariables variables; a quantity of more variables is differentiated in
 // blocks of half that many, one evaluation per pair of blocks (each pair gives its blocks of the
 // gradient and the Hessian), so the group's dimension is not limited by the jet's capacity.
 #pragma once
 
 #include <Eigen/Core>
+#include <unsupported/Eigen/AutoDiff>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -44,6 +48,10 @@ namespace varia::sdk {
 
 // The size of a scalar and its derivatives (for the series' stopping rule).
 inline double magnitude(double x) { return std::abs(x); }
+template <class Derivatives>
+double magnitude(const Eigen::AutoDiffScalar<Derivatives>& x) {
+  return std::max(std::abs(x.value()), x.derivatives().template lpNorm<Eigen::Infinity>());
+}
 inline double magnitude(const Jet2& x) {
   double m = std::abs(x.value);
   if (!x.constant())
@@ -70,6 +78,27 @@ void dexp_series(const T* xi, const T* v, T* out) {
       total = std::max(total, magnitude(out[i]));
     }
     small = size <= 1e-17 * total ? small + 1 : 0;
+  }
+}
+
+// Up to this many variables, first derivatives alone are taken at first-order duals on the stack
+// ((V + K)(V + 1) numbers); a larger group's are read off jets.
+inline constexpr int kMaxFirstOrderVariables = 32;
+
+// Value and gradient (Derivatives' layout, no Hessian) of f: R^V -> R^K at x, at first-order
+// dual numbers over exactly V variables: V + 1 numbers a scalar instead of a second-order jet's
+// 1 + V + V^2 (a chart asked for first derivatives only, as in a simplified Newton iteration).
+template <int V, int K, class F>
+void differentiate_first_order(F&& f, const double* x, Derivatives out) {
+  using Dual = Eigen::AutoDiffScalar<Eigen::Matrix<double, V, 1>>;
+  std::array<Dual, V> xs;
+  std::array<Dual, K> ys;
+  for (int i = 0; i < V; ++i) xs[i] = Dual(x[i], V, i);
+  f(static_cast<const Dual*>(xs.data()), ys.data());
+  for (int k = 0; k < K; ++k) {
+    if (out.value != nullptr) out.value[k] = ys[k].value();
+    if (out.gradient != nullptr)
+      for (int i = 0; i < V; ++i) out.gradient[k * V + i] = ys[k].derivatives()[i];
   }
 }
 
@@ -162,16 +191,14 @@ class LieGroupManifold : public Manifold {
           x_[i] = 0.0;
           x_[n + i] = xi[i];
         }
-        differentiate([&](const auto* y, auto* g) { chart_point(q0, y, g); }, x_.data(), 2 * n, m,
-                      point, xs_.data(), ys_.data());
+        derivatives<2 * n, m>([&](const auto* y, auto* g) { chart_point(q0, y, g); }, x_.data(), point);
       }
       if (velocity.value != nullptr || velocity.gradient != nullptr || velocity.hessian != nullptr) {
         for (int i = 0; i < n; ++i) {
           x_[i] = xi[i];
           x_[n + i] = xi_dot[i];
         }
-        differentiate([](const auto* y, auto* v) { chart_velocity(y, v); }, x_.data(), 2 * n, n,
-                      velocity, xs_.data(), ys_.data());
+        derivatives<2 * n, n>([](const auto* y, auto* v) { chart_velocity(y, v); }, x_.data(), velocity);
       }
     });
   }
@@ -180,8 +207,8 @@ class LieGroupManifold : public Manifold {
     return guarded(error_, [&] {
       double inverse[m];
       Group::inverse(q0, inverse);
-      differentiate([&](const auto* y, auto* w) { chart_local(inverse, y, w); }, q, m, n, xi,
-                    xs_.data(), ys_.data());
+      differentiate([&](const auto* y, auto* w) { chart_local(inverse, y, w); }, q, m, n, xi, xs_.data(),
+                    ys_.data());
     });
   }
 
@@ -217,6 +244,15 @@ class LieGroupManifold : public Manifold {
   std::string error_;
 
  private:
+  // f's derivatives at x into out: first-order duals when no Hessian is asked and the duals fit
+  // on the stack (kMaxFirstOrderVariables), else jets in blocks.
+  template <int V, int K, class F>
+  void derivatives(F&& f, const double* x, Derivatives out) {
+    if constexpr (V <= kMaxFirstOrderVariables) {
+      if (out.hessian == nullptr) return differentiate_first_order<V, K>(f, x, out);
+    }
+    differentiate(f, x, V, K, out, xs_.data(), ys_.data());
+  }
   template <class T>
   static void chart_point(const double* q0, const T* y, T* point) {
     T a[m], b[m], ab[m];

@@ -6,7 +6,10 @@
 //   - the chart's point gradient in xi at 0 is D(q), and its velocity gives antisymmetric
 //     structure constants [e_a, e_b] = -[e_b, e_a];
 //   - translate at jets is retract at the values, with derivative D(q) in xi at 0;
-//   - local_derivatives' gradient at q0 = q is a left inverse of D(q).
+//   - local_derivatives' gradient at q0 = q is a left inverse of D(q);
+//   - at a point xi away from 0, the chart's first derivatives asked alone (as a simplified
+//     Newton iteration asks them) are those asked with the Hessian, and the Hessian is the
+//     derivative of the gradient (Taylor test).
 // A group whose composition is not affine in its second factor fails the generators' Taylor
 // test (the SDK's adapter derives D(q) from the composition, varia/sdk/lie_group.hpp).
 #pragma once
@@ -41,6 +44,53 @@ inline Eigen::MatrixXd generators(Manifold& manifold, const Eigen::VectorXd& q) 
   for (int k = 0; k < m; ++k)
     for (int a = 0; a < n; ++a) out(k, a) = D[k * n + a].value;
   return out;
+}
+
+// The chart's point (in (eta, xi)) and velocity (in (xi, xi_dot)) at (xi, xi_dot): gradient alone,
+// and gradient with Hessian; the two gradients agree, and the Hessian passes a Taylor test of the
+// gradient in the direction u (2n numbers).
+inline void check_chart_at(Failures& failures, Manifold& manifold, const Eigen::VectorXd& q, const Eigen::VectorXd& xi,
+                           const Eigen::VectorXd& xi_dot, const Eigen::VectorXd& u, double scale) {
+  const int m = manifold.point_size(), n = manifold.dim(), V = 2 * n;
+  struct Chart {
+    Eigen::VectorXd point_gradient, velocity_gradient, point_hessian, velocity_hessian;
+  };
+  const auto chart = [&](const Eigen::VectorXd& at, const Eigen::VectorXd& rate, bool hessian) {
+    Chart c{Eigen::VectorXd(m * V), Eigen::VectorXd(n * V), Eigen::VectorXd(m * V * V), Eigen::VectorXd(n * V * V)};
+    const bool ok = manifold.chart(q.data(), at.data(), rate.data(),
+                                   {nullptr, c.point_gradient.data(), hessian ? c.point_hessian.data() : nullptr},
+                                   {nullptr, c.velocity_gradient.data(), hessian ? c.velocity_hessian.data() : nullptr}) == nullptr;
+    if (!ok) c.point_gradient.setConstant(NAN);
+    return c;
+  };
+  const Chart alone = chart(xi, xi_dot, false), full = chart(xi, xi_dot, true);
+  const double difference = std::max((alone.point_gradient - full.point_gradient).lpNorm<Eigen::Infinity>(),
+                                     (alone.velocity_gradient - full.velocity_gradient).lpNorm<Eigen::Infinity>());
+  failures.expect(difference <= 1e-12 * scale,
+                  "the chart's gradient asked without the Hessian differs from the one asked with it by ", difference);
+  // The point's gradient in (eta, xi) moves with xi only through the xi block; the velocity's with
+  // both of (xi, xi_dot). Remainder of the first-order model of the gradients along u.
+  const auto remainder = [&](double eps) {
+    const Eigen::VectorXd moved_xi = xi + eps * u.tail(n), moved_rate = xi_dot + eps * u.head(n);
+    const Chart c = chart(moved_xi, moved_rate, false);
+    Eigen::VectorXd point_step = Eigen::VectorXd::Zero(V), velocity_step(V);
+    point_step.tail(n) = u.tail(n);
+    velocity_step << u.tail(n), u.head(n);
+    double r = 0.0;
+    for (int k = 0; k < m; ++k) {
+      const Eigen::Map<const Eigen::MatrixXd> H(full.point_hessian.data() + k * V * V, V, V);
+      r = std::max(r, (c.point_gradient.segment(k * V, V) - full.point_gradient.segment(k * V, V) - eps * H * point_step)
+                          .lpNorm<Eigen::Infinity>());
+    }
+    for (int k = 0; k < n; ++k) {
+      const Eigen::Map<const Eigen::MatrixXd> H(full.velocity_hessian.data() + k * V * V, V, V);
+      r = std::max(r, (c.velocity_gradient.segment(k * V, V) - full.velocity_gradient.segment(k * V, V) -
+                       eps * H * velocity_step)
+                          .lpNorm<Eigen::Infinity>());
+    }
+    return r;
+  };
+  expect_taylor(failures, remainder, scale, "the chart's Hessian is not the derivative of its gradient");
 }
 
 }  // namespace detail
@@ -111,6 +161,7 @@ inline Failures check_lie_group(Manifold& manifold, const Eigen::VectorXd& q, st
   failures.expect((left - Eigen::MatrixXd::Identity(n, n)).lpNorm<Eigen::Infinity>() <= 1e-12 * scale,
                   "local_derivatives' gradient is not a left inverse of the generators (off by ",
                   (left - Eigen::MatrixXd::Identity(n, n)).lpNorm<Eigen::Infinity>(), ")");
+  detail::check_chart_at(failures, manifold, q, xi, random_direction(n, engine), random_direction(2 * n, engine), scale);
   return failures;
 }
 
