@@ -286,19 +286,20 @@ void GalerkinDiscreteLagrangian::take_steps(double* q, double* p, double t0, dou
   (this->*explicit_advance_)(q, p, h, steps);
 }
 
-// q_i = q^0 + sum_nu l_nu(c_i) (q^nu - q^0) (sum_nu l_nu = 1), v_i = (1/h) sum_nu l'_nu(c_i) (q^nu - q^0).
+// q_i = q^0 + sum_nu l_nu(c_i) (q^nu - q^0) (sum_nu l_nu = 1), v_i = (1/h) sum_nu l'_nu(c_i) (q^nu - q^0),
+// into q and v (n numbers each).
 // Plain loops over contiguous arrays: at small n a matrix-vector product's setup would cost more
 // than its arithmetic. For a fixed N the sums run in local accumulators (registers) and are
-// stored once: summed in q_'s and v_'s memory, each addition waited for the store before it (at
-// s = 6 the stores were half of the action's time).
+// stored once: summed in q's and v's memory, each addition waited for the store before it (at
+// s = 6 the stores were half of the action's time). Inlined into both callers (a call added 12%
+// to the s = 2 Gauss step).
 template <int N>
-void GalerkinDiscreteLagrangian::interpolate(int i, double h) {
+[[gnu::always_inline]] inline void GalerkinDiscreteLagrangian::interpolate(int i, double h, double* __restrict q,
+                                                                            double* __restrict v) {
   const int n = N == Eigen::Dynamic ? n_ : N;
   const double* __restrict a = basis_.phi.col(i).data();
   const double* __restrict da = basis_.dphi.col(i).data();
   const double* __restrict points = points_.data();
-  double* __restrict q = q_.data();
-  double* __restrict v = v_.data();
   std::array<double, N == Eigen::Dynamic ? 1 : N> q_sum{}, v_sum{};
   double* qs = N == Eigen::Dynamic ? q : q_sum.data();
   double* vs = N == Eigen::Dynamic ? v : v_sum.data();
@@ -341,7 +342,7 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
   if (order == Order::hessian && !sparse) hessian_.setZero();
   for (int i = 0; i < basis_.phi.cols(); ++i) {
     if (weights_[i] == 0.0) continue;
-    interpolate<N>(i, h);
+    interpolate<N>(i, h, q_.data(), v_.data());
     double L = 0.0;
     if (order == Order::hessian && sparse)
       L = lagrangian_.sparse_hessian(q_.data(), v_.data(), grad_.data(), sparse_values_.data());
@@ -363,23 +364,23 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
     if (forced) add_forces(i, h, order);
     if (order == Order::hessian && sparse)
       add_sparse_entries(i, h, 0, sparse_values_.data(), static_cast<int>(sparse_values_.size()), h * b);
-    add_gradient<N>(i, h, b);
+    add_gradient<N>(i, h, b, grad_.data(), gradient_.data(), 0, s_ + 1);
     if (order == Order::hessian && !sparse) add_hessian<N>(i, h, b);
   }
   return S;
 }
 
-// gradient_ (nu n + r) += b (h l_nu L_q + l'_nu L_v)(r) at node i (see action()).
+// out ((nu - first) n + r) += b (h l_nu L_q + l'_nu L_v)(r) at node i (see action()), for the
+// control points nu in [first, first + count), dL = [L_q; L_v].
 template <int N>
-void GalerkinDiscreteLagrangian::add_gradient(int i, double h, double b) {
+[[gnu::always_inline]] inline void GalerkinDiscreteLagrangian::add_gradient(int i, double h, double b, const double* __restrict dL,
+                                              double* __restrict out, int first, int count) {
   const int n = N == Eigen::Dynamic ? n_ : N;
-  const double* __restrict a = basis_.phi.col(i).data();
-  const double* __restrict da = basis_.dphi.col(i).data();
-  const double* __restrict dL = grad_.data();  // [L_q; L_v]
-  double* __restrict gradient = gradient_.data();
-  for (int nu = 0; nu <= s_; ++nu) {
+  const double* __restrict a = basis_.phi.col(i).data() + first;
+  const double* __restrict da = basis_.dphi.col(i).data() + first;
+  for (int nu = 0; nu < count; ++nu) {
     const double x = b * h * a[nu], y = b * da[nu];
-    for (int r = 0; r < n; ++r) gradient[nu * n + r] += x * dL[r] + y * dL[n + r];
+    for (int r = 0; r < n; ++r) out[nu * n + r] += x * dL[r] + y * dL[n + r];
   }
 }
 
@@ -486,18 +487,43 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
 
 // F at the control points in points_ into F (s n): action()'s dS/dq^nu (the plugin's L_v, not
 // K M q^mu / h: K's entries are rounded once, and that rounding, the same at every step, moved the
-// solution by an ulp a step), with p0 added to the equation nu = 0. The nodes' forces are kept in
-// node_forces_ for the next step's warm start. Returns F's round-off yardstick, as
-// Equations::evaluate.
+// solution by an ulp a step), with p0 added to the equation nu = 0, summed node by node straight
+// into F (issue #19: the step is a chain of dependent passes through memory; a pass into the
+// action's gradient and a copy of it into F made that chain two stores and loads longer). For a
+// fixed N the plugin reads q, v and writes [L_q, L_v] in one small local array, as in
+// explicit_advance. dS/dq^s is summed only for the yardstick (into gradient_'s last block), and
+// dS/dq^0 is kept in gradient_'s first block for finish(). The nodes' forces are kept in
+// node_forces_ for the next step's warm start, impulse_ as in action(). Returns F's round-off
+// yardstick, as Equations::evaluate.
 template <int N>
-double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p0, double* F) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = s_;
-  action_for<N>(h, Order::gradient, false);
-  const double* __restrict gradient = gradient_.data();
+double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p0, double* __restrict F) {
+  const int n = N == Eigen::Dynamic ? n_ : N, s = s_, r = static_cast<int>(weights_.size());
+  alignas(64) std::array<double, N == Eigen::Dynamic ? 1 : 4 * N> io{};  // q, v, then [L_q, L_v]
+  double* q = N == Eigen::Dynamic ? q_.data() : io.data();
+  double* v = N == Eigen::Dynamic ? v_.data() : io.data() + n;
+  double* dL = N == Eigen::Dynamic ? grad_.data() : io.data() + 2 * n;
+  double* __restrict last = gradient_.data() + s * n;
+  double* __restrict impulse = impulse_.data();
+  double* __restrict forces = node_forces_.data();
+  for (int k = 0; k < s * n; ++k) F[k] = 0.0;
+  for (int c = 0; c < n; ++c) last[c] = impulse[c] = 0.0;
+  for (int i = 0; i < r; ++i) {
+    const double b = weights_[i];
+    if (b == 0.0) continue;
+    interpolate<N>(i, h, q, v);
+    lagrangian_.gradient(q, v, dL);
+    for (int c = 0; c < n; ++c) {
+      impulse[c] += (h * b) * dL[c];
+      forces[i * n + c] = dL[c];
+    }
+    add_gradient<N>(i, h, b, dL, F, 0, s);
+    add_gradient<N>(i, h, b, dL, last, s, 1);
+  }
   double yardstick = 0.0;
-  for (int k = 0; k < (s + 1) * n; ++k) yardstick = std::max(yardstick, std::abs(gradient[k]));
-  for (int k = 0; k < s * n; ++k) F[k] = gradient[k];
+  for (int k = 0; k < s * n; ++k) yardstick = std::max(yardstick, std::abs(F[k]));
   for (int c = 0; c < n; ++c) {
+    yardstick = std::max(yardstick, std::abs(last[c]));
+    gradient_[c] = F[c];
     F[c] += p0[c];
     yardstick = std::max(yardstick, std::abs(p0[c]));
   }
@@ -524,18 +550,22 @@ void GalerkinDiscreteLagrangian::simplified_update(double h, const double* F, do
 }
 
 // The step's equations as a NewtonSolver system with the simplified Jacobian: solve() applies its
-// inverse, finish() brings dS/dq^nu up to date by the kinetic part of the last update (exactly:
-// it is linear; the forces' part of the change is the residual the stopping rule leaves, below
-// F's rounding).
+// inverse, finish() takes the impulse less the equations' residuals at the updated points (see
+// take_step), their kinetic part brought up to date by the last update (exactly: it is linear;
+// the forces' part of the change is the residual the stopping rule leaves, below F's rounding).
 template <int N>
 struct GalerkinDiscreteLagrangian::Simplified {
   GalerkinDiscreteLagrangian& g;
   double h;
   const double* p0;
+  const double* residual = nullptr;  // F at the last evaluation (the solver's)
 
   int size() const { return g.s_ * g.n_; }
   bool simplified() const { return true; }
-  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.simplified_residual<N>(h, p0, F.data()); }
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
+    residual = F.data();
+    return g.simplified_residual<N>(h, p0, F.data());
+  }
   void factorize() {}  // K^{-1} and M^{-1} are formed when the map is built
   void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { g.simplified_update<N>(h, F.data(), update.data()); }
   double apply(const Eigen::VectorXd& update) {
@@ -549,11 +579,14 @@ struct GalerkinDiscreteLagrangian::Simplified {
     for (int c = 0; c < n; ++c) origin = std::max(origin, std::abs(g.origin_[c]));
     return origin + largest;
   }
+  // impulse_ -= (dS/dq^0 + p0) + sum_{0 < nu < s} dS/dq^nu at the updated points, dS/dq^nu less
+  // (1/h) M sum_mu K_numu update^mu (dS/dq^0 from gradient_, the others from F).
   void finish(const Eigen::VectorXd& update) {
     const int n = N == Eigen::Dynamic ? g.n_ : N, s = g.s_;
     const double* __restrict K = g.stiffness_.data();
     const double* __restrict M = g.mass_matrix_.data();
     double* __restrict kinetic = g.kinetic_.data();
+    double* __restrict impulse = g.impulse_.data();
     for (int nu = 0; nu < s; ++nu) {
       for (int c = 0; c < n; ++c) kinetic[c] = 0.0;
       for (int mu = 1; mu <= s; ++mu)
@@ -561,7 +594,10 @@ struct GalerkinDiscreteLagrangian::Simplified {
       for (int c = 0; c < n; ++c) {
         double m = 0.0;
         for (int d = 0; d < n; ++d) m += M[c + d * n] * kinetic[d];
-        g.gradient_[nu * n + c] -= m / h;
+        if (nu == 0)
+          impulse[c] -= (g.gradient_[c] - m / h) + p0[c];
+        else
+          impulse[c] -= residual[nu * n + c] - m / h;
       }
     }
   }
@@ -634,7 +670,14 @@ struct GalerkinDiscreteLagrangian::Equations {
     g.points_.middleCols(first_unknown, blocks).reshaped() -= update;
     return g.origin_.lpNorm<Eigen::Infinity>() + g.points_.lpNorm<Eigen::Infinity>();
   }
-  void finish(const Eigen::VectorXd& update) { g.gradient_after_update(h, first_unknown, update, forced); }
+  // The gradient at the updated points; for the step's equations (p0 given), impulse_ less their
+  // residuals there (see take_step).
+  void finish(const Eigen::VectorXd& update) {
+    g.gradient_after_update(h, first_unknown, update, forced);
+    if (p0 == nullptr) return;
+    g.impulse_ -= g.gradient_.head(g.n_) + Eigen::Map<const Eigen::VectorXd>(p0, g.n_);
+    for (int nu = 1; nu < g.s_; ++nu) g.impulse_ -= g.gradient_.segment(nu * g.n_, g.n_);
+  }
 };
 
 // Eigen's SparseLU: the symbolic analysis (COLAMD ordering) once per structure, the numerical
@@ -704,8 +747,9 @@ void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, 
 // q1 = q0 + (q^s - q^0), and p1 = D2 L_d + f_d^s written as p0 plus its change: the equations
 // sum to sum_nu (dS/dq^nu + f_d^nu) = impulse_ (see action()), so
 //   p1 - p0 = impulse_ - (dS/dq^0 + f_d^0 + p0) - sum_{0 < nu < s} (dS/dq^nu + f_d^nu),
-// the impulse less the residuals of the solved equations. Both sums are compensated across steps
-// (compensated.hpp) when a step continues from the last one's output.
+// the impulse less the residuals of the solved equations (formed by the solve's finish(), where the
+// residuals are at hand). Both sums are compensated across steps (compensated.hpp) when a step
+// continues from the last one's output.
 void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, double t0, double h, double* q1,
                                            double* p1) {
   if (explicit_advance_ != nullptr) {
@@ -720,9 +764,7 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   }
   t_ = t0;
   warm_start(q0, p0, h);
-  newton(h, 1, 0, s_, p0, !forces_.empty());
-  impulse_ -= gradient_.head(n_) + momentum;
-  for (int nu = 1; nu < s_; ++nu) impulse_ -= gradient_.segment(nu * n_, n_);
+  newton(h, 1, 0, s_, p0, !forces_.empty());  // impulse_ is then p1 - p0 (the solvers' finish())
   Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);
   previous_end_ = start;
   compensated_add(previous_end_, points_.col(s_), carry_q_);
@@ -731,7 +773,7 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   end = previous_end_;
   momentum1 = end_p_;
   if (predict_ != nullptr)
-    previous_forces_ = node_forces_;
+    previous_forces_.swap(node_forces_);  // node_forces_ is written again before it is read
   else
     previous_ = points_;
   previous_h_ = h;

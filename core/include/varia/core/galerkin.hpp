@@ -92,13 +92,14 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N>
   double action_for(double h, Order order, bool forced);
   using ActionFunction = double (GalerkinDiscreteLagrangian::*)(double, Order, bool);
-  // The interpolant at quadrature node i: q_, v_.
+  // The interpolant at quadrature node i into q and v.
   template <int N>
-  void interpolate(int i, double h);
+  void interpolate(int i, double h, double* q, double* v);
   void add_forces(int i, double h, Order order);
-  // The gradient's and the dense Hessian's terms of node i with weight b (see action()).
+  // The gradient's terms of node i with weight b and dL = [L_q; L_v] there, for the control
+  // points [first, first + count), into out; the dense Hessian's (see action()).
   template <int N>
-  void add_gradient(int i, double h, double b);
+  void add_gradient(int i, double h, double b, const double* dL, double* out, int first, int count);
   template <int N>
   void add_hessian(int i, double h, double b);
   // dq_i/dq^nu = l_nu(c_i), dv_i/dq^nu = l'_nu(c_i)/h: the weight of an entry's row or column.
