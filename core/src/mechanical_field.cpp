@@ -41,16 +41,25 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       gradient_(2 * n_),
       hessian_(2 * n_, 2 * n_),
       velocity_q_(n_, n_),
+      inverse_mass_at_(n_, n_),
+      identity_(Eigen::MatrixXd::Identity(n_, n_)),
+      rhs_(n_),
       mass_lu_(n_),
       v_jet_(n_),
       gradient_jet_(2 * n_),
-      legendre_residual_(2 * n_) {
-  if (space == PhaseSpace::tangent && !constant_mass_)
+      legendre_residual_(2 * n_),
+      hessian_jet_(4 * n_ * n_),
+      seed_(2 * n_),
+      acceleration_jet_(n_) {
+  const int needed = 2 * n_, given = lagrangian.plugin().hessian_jet_variables();
+  if (space == PhaseSpace::tangent && !constant_mass_ && given < needed)
     throw std::invalid_argument(
-        "the tangent form (q, v) of the Euler-Lagrange field needs a Lagrangian with a constant mass matrix, "
-        "L = 1/2 v^T M v - V(q) (Lagrangian::constant_mass_matrix): with a configuration-dependent one its "
-        "derivatives need L's Hessian at jets, which the Lagrangian interface does not give; this one declares "
-        "none. Integrate in (q, p): the shooting construction's \"form\": \"hamiltonian\"");
+        "the tangent form (q, v) of the Euler-Lagrange field with a configuration-dependent mass matrix needs "
+        "the Lagrangian's Hessian at jets of " + std::to_string(needed) + " variables (Lagrangian::hessian_jet: "
+        "the acceleration M^{-1} (L_q - L_vq v) and its second-order jets need L's derivatives to fourth order); "
+        "this one declares no constant mass matrix and gives its Hessian at jets of at most " +
+        std::to_string(given) + " variables (sdk::AutodiffLagrangian: 6, i.e. R^1..R^3). Integrate in (q, p): "
+        "the shooting construction's \"form\": \"hamiltonian\"");
   v_.setZero();
 }
 
@@ -87,7 +96,7 @@ void MechanicalField::velocity(const Jet2* y, Jet2* v) {
   velocity_of_momentum(position_.data(), force_.data());
   lagrangian_.hessian(position_.data(), v_.data(), gradient_.data(), hessian_.data());
   mass_lu_.compute(hessian_.bottomRightCorner(n_, n_));
-  velocity_q_ = mass_lu_.inverse();  // M^{-1} at the values
+  velocity_q_.noalias() = mass_lu_.solve(identity_);  // M^{-1} at the values (inverse() would allocate)
   for (int r = 0; r < n_; ++r) v[r] = Jet2(v_[r]);
   for (int iteration = 0; iteration < 2; ++iteration) {
     lagrangian_.gradient_jet(q, v, nullptr, legendre_residual_.data());
@@ -137,12 +146,15 @@ void MechanicalField::add_forces(const double* y, const double* q, bool jacobian
 }
 
 void MechanicalField::force(const Jet2* state, const Jet2* v, Jet2* f) {
-  const Jet2* y = point(state);
+  force_at(point(state), v, state[2 * n_].value, f);
+}
+
+void MechanicalField::force_at(const Jet2* y, const Jet2* v, double t, Jet2* f) {
   for (int r = 0; r < n_; ++r) {
     position_[r] = y[r].value;
     v_[r] = v[r].value;
   }
-  forces_->evaluate(state[2 * n_].value, position_.data(), v_.data(), force_.data(), force_jacobian_.data());
+  forces_->evaluate(t, position_.data(), v_.data(), force_.data(), force_jacobian_.data());
   for (int r = 0; r < n_; ++r) f[r] = Jet2(force_[r]);
   for (std::size_t e = 0; e < forces_->rows().size(); ++e) {
     const int col = forces_->cols()[e];
@@ -156,11 +168,13 @@ Status MechanicalField::eval(const double* y, double* f) noexcept {
     const double* q = point(y);
     if (space_ == PhaseSpace::cotangent) velocity_of_momentum(q, y + n_);
     else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
-    lagrangian_.gradient(q, v_.data(), gradient_.data());
+    if (general_tangent()) lagrangian_.hessian(q, v_.data(), gradient_.data(), hessian_.data());
+    else lagrangian_.gradient(q, v_.data(), gradient_.data());
     if (forced_) add_forces(y, q, false);
     Eigen::Map<Eigen::VectorXd>(f, n_) = v_;
     if (space_ == PhaseSpace::cotangent) Eigen::Map<Eigen::VectorXd>(f + n_, n_) = gradient_.head(n_);
-    else inverse_mass(gradient_.data(), f + n_);
+    else if (constant_mass_) inverse_mass(gradient_.data(), f + n_);
+    else acceleration(f + n_);
     if (clock()) f[2 * n_] = 1.0;
   });
 }
@@ -175,12 +189,14 @@ Status MechanicalField::eval(const Jet2* y, Jet2* f) noexcept {
     }
     std::copy(v_jet_.begin(), v_jet_.end(), f);
     if (space_ == PhaseSpace::cotangent) std::copy_n(gradient_jet_.begin(), n_, f + n_);
-    else inverse_mass(gradient_jet_.data(), f + n_);
+    else if (constant_mass_) inverse_mass(gradient_jet_.data(), f + n_);
+    else acceleration(point(y), v_jet_.data(), f + n_);
     if (clock()) f[2 * n_] = Jet2(1.0);
   });
 }
 
-// Tangent:   df = [0, I; M^{-1} L_qq, M^{-1} L_qv].
+// Tangent:   df = [0, I; M^{-1} L_qq, M^{-1} L_qv]; with a configuration-dependent mass matrix
+//            general_tangent_jacobian().
 // Cotangent: df = [0, M^{-1}; L_qq, L_qv M^{-1}]  (v = M^{-1} p); with a configuration-dependent
 // mass matrix M = L_vv (q, v), cotangent_jacobian().
 // With forces, L_q + f in place of L_q, and the time's row and column zero: t' = 1 is constant,
@@ -189,6 +205,7 @@ Status MechanicalField::eval(const Jet2* y, Jet2* f) noexcept {
 // solve; the values at convergence and the jets are exact).
 Status MechanicalField::jacobian(const double* y, double* f, double* df) noexcept {
   return guard([&] {
+    if (general_tangent()) return general_tangent_jacobian(y, f, df);
     const double* q = point(y);
     if (space_ == PhaseSpace::cotangent) velocity_of_momentum(q, y + n_);
     else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
@@ -222,12 +239,78 @@ Status MechanicalField::jacobian(const double* y, double* f, double* df) noexcep
 // g_q + g_v v_q and g_v v_p.
 void MechanicalField::cotangent_jacobian(Eigen::Ref<Eigen::MatrixXd> J) {
   mass_lu_.compute(hessian_.bottomRightCorner(n_, n_));
-  J.block(0, n_, n_, n_) = mass_lu_.inverse();
+  J.block(0, n_, n_, n_).noalias() = mass_lu_.solve(identity_);
   velocity_q_.noalias() = -J.block(0, n_, n_, n_) * hessian_.bottomLeftCorner(n_, n_);
   J.block(0, 0, n_, n_) = velocity_q_;
   J.block(n_, 0, n_, n_) = hessian_.topLeftCorner(n_, n_);
   J.block(n_, 0, n_, n_).noalias() += hessian_.topRightCorner(n_, n_) * velocity_q_;
   J.block(n_, n_, n_, n_).noalias() = hessian_.topRightCorner(n_, n_) * J.block(0, n_, n_, n_);
+}
+
+// a = M^{-1} (L_q + f - L_vq v) at doubles, M = L_vv, from gradient_ (with the forces) and hessian_.
+void MechanicalField::acceleration(double* a) {
+  rhs_ = gradient_.head(n_);
+  rhs_.noalias() -= hessian_.bottomLeftCorner(n_, n_) * v_;
+  mass_lu_.compute(hessian_.bottomRightCorner(n_, n_));
+  Eigen::Map<Eigen::VectorXd>(a, n_) = mass_lu_.solve(rhs_);
+}
+
+// a = M^{-1} (L_q + f - L_vq v) at jets (L_q + f in gradient_jet_), M = L_vv: L's Hessian at jets
+// gives M and L_vq; the linear solve at jets starts from M0^{-1} (L_q + f - L_vq v), M0 the mass
+// matrix's values, and takes two corrections a += M0^{-1} (rhs - M a): the error's value part is
+// zero and each correction multiplies it by I - M0^{-1} M, whose value part is zero, so that the
+// first and then the second derivatives become exact (as in velocity()).
+void MechanicalField::acceleration(const Jet2* q, const Jet2* v, Jet2* a) {
+  lagrangian_.hessian_jet(q, v, hessian_jet_.data());
+  const int k = 2 * n_;
+  const auto H = [&](int r, int c) -> const Jet2& { return hessian_jet_[c * k + r]; };
+  for (int r = 0; r < n_; ++r) {
+    Jet2& rhs = legendre_residual_[r] = gradient_jet_[r];
+    for (int c = 0; c < n_; ++c) rhs -= H(n_ + r, c) * v[c];
+    for (int c = 0; c < n_; ++c) velocity_q_(r, c) = H(n_ + r, n_ + c).value;
+  }
+  mass_lu_.compute(velocity_q_);
+  inverse_mass_at_.noalias() = mass_lu_.solve(identity_);  // inverse() would allocate
+  const auto add_solution = [&](const Jet2* rhs) {
+    for (int r = 0; r < n_; ++r)
+      for (int c = 0; c < n_; ++c) a[r] += inverse_mass_at_(r, c) * rhs[c];
+  };
+  std::fill_n(a, n_, Jet2(0.0));
+  add_solution(legendre_residual_.data());
+  for (int iteration = 0; iteration < 2; ++iteration) {
+    for (int r = 0; r < n_; ++r) {
+      Jet2& residual = legendre_residual_[n_ + r] = legendre_residual_[r];
+      for (int c = 0; c < n_; ++c) residual -= H(n_ + r, n_ + c) * a[c];
+    }
+    add_solution(legendre_residual_.data() + n_);
+  }
+}
+
+// The tangent form's Jacobian with a configuration-dependent mass matrix: the acceleration at jets
+// whose variables are (q, v) themselves (2n of them), read off their gradients; the forces enter
+// through their Jacobian (force_at), the time's column is zero as in jacobian().
+void MechanicalField::general_tangent_jacobian(const double* y, double* f, double* df) {
+  const double* q = point(y);
+  for (int r = 0; r < n_; ++r) {
+    seed_[r] = Jet2::variable(q[r], 2 * n_, r);
+    v_jet_[r] = Jet2::variable(y[n_ + r], 2 * n_, n_ + r);
+  }
+  lagrangian_.gradient_jet(seed_.data(), v_jet_.data(), nullptr, gradient_jet_.data());
+  if (forced_) {
+    force_at(seed_.data(), v_jet_.data(), y[2 * n_], force_jet_.data());
+    for (int r = 0; r < n_; ++r) gradient_jet_[r] += force_jet_[r];
+  }
+  acceleration(seed_.data(), v_jet_.data(), acceleration_jet_.data());
+  const int N = size();
+  Eigen::Map<Eigen::MatrixXd> J(df, N, N);
+  J.setZero();
+  J.block(0, n_, n_, n_).setIdentity();
+  for (int r = 0; r < n_; ++r) {
+    f[r] = y[n_ + r];
+    f[n_ + r] = acceleration_jet_[r].value;
+    J.row(n_ + r).head(2 * n_) = acceleration_jet_[r].gradient.transpose();
+  }
+  if (clock()) f[2 * n_] = 1.0;
 }
 
 namespace {

@@ -90,6 +90,15 @@ void LagrangianEvaluator::gradient_jet(const Jet2* q, const Jet2* v, Jet2* value
     throw NumericalFailure("the Lagrangian's gradient at jets is not finite", std::nan(""), lagrangian_.origin());
 }
 
+void LagrangianEvaluator::hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian) {
+  check(lagrangian_, lagrangian_.hessian_jet(q, v, hessian), "Lagrangian Hessian at jets");
+  ++counters_.hessian;
+  const int k = m_ + n_;
+  for (int i = 0; i < k * k; ++i)
+    if (!isfinite(hessian[i]))
+      throw NumericalFailure("the Lagrangian's Hessian at jets is not finite", std::nan(""), lagrangian_.origin());
+}
+
 void LagrangianEvaluator::legendre(const double* q, const double* v, double* p) {
   gradient(q, v, gradient_.data());
   Eigen::Map<Eigen::VectorXd>(p, n_) = gradient_.tail(n_);

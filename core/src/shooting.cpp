@@ -388,7 +388,8 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
                                       double* p1) {
   forced_ = !forces_.empty();
   t_ = t0;
-  if (form_ == ShootingForm::lagrangian) field_->inverse_mass(p0, w_.data());
+  if (form_ == ShootingForm::lagrangian && field_->constant_mass()) field_->inverse_mass(p0, w_.data());
+  else if (form_ == ShootingForm::lagrangian) mechanical_->velocity_of(q0, p0, w_.data());
   else w_ = Eigen::Map<const Eigen::VectorXd>(p0, n_);
   target_is_end_ = true;
   solve(q0, h, Target::momentum, p0);

@@ -8,8 +8,10 @@
 #include <cstddef>
 
 #include "core/fixtures.hpp"
+#include "core/shooting_fixtures.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/galerkin_chart.hpp"
+#include "varia/core/shooting.hpp"
 #include "varia/sdk/groups/so3.hpp"
 
 extern "C" void* __libc_malloc(std::size_t size);  // glibc's own malloc, always exported
@@ -117,4 +119,29 @@ TEST_CASE("lie group galerkin steps allocate nothing through the sdk's generic c
   });
   CHECK(count == 0);
   CHECK(map.solver_statistics().iterations > 100);
+}
+
+TEST_CASE("shooting steps with a configuration-dependent mass matrix allocate nothing: the lagrangian form (the "
+          "acceleration from L's Hessian at jets, the implicit stages' Jacobian from it) and the hamiltonian form (the "
+          "inverse Legendre transform at jets, which allocated 66 times a step through PartialPivLU::inverse)") {
+  Pendulum pendulum;  // declares no mass matrix
+  FlatSpace space(1);
+  auto rule = lobatto3();
+  for (ShootingForm form : {ShootingForm::lagrangian, ShootingForm::hamiltonian})
+    for (bool implicit : {false, true}) {
+      CAPTURE(form == ShootingForm::lagrangian);
+      CAPTURE(implicit);
+      sdk::RungeKutta method = implicit ? gauss2() : rk4();
+      ShootingDiscreteLagrangian map(space, pendulum, rule, method, form, {});
+      double q = 1.3, p = 0.2, q1, p1;
+      map.step(&q, &p, 0.1, &q1, &p1);
+      const long count = allocations_of([&] {
+        for (int k = 0; k < 50; ++k) {
+          map.step(&q1, &p1, 0.1, &q, &p);
+          std::swap(q, q1);
+          std::swap(p, p1);
+        }
+      });
+      CHECK(count == 0);
+    }
 }

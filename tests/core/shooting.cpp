@@ -300,30 +300,59 @@ TEST_CASE("a shooting solve that does not converge raises a numerical failure") 
   }
 }
 
-TEST_CASE("without a declared constant mass matrix the lagrangian form is refused, the hamiltonian form and the "
-          "one-step construction integrate (q, p) through the exact inverse Legendre transform, giving the "
-          "declared-mass trajectory to round-off") {
-  Pendulum pendulum;  // declares no mass matrix: v(q, p) by Newton's method, at doubles and at jets
+namespace {
+
+// Four unit pendulums declaring no mass matrix: the lagrangian form would need L's Hessian at jets
+// of 8 variables, and the SDK gives it at up to 6.
+struct FourPendulums : sdk::AutodiffLagrangian<FourPendulums> {
+  FourPendulums() : sdk::AutodiffLagrangian<FourPendulums>(4, 4) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::cos;
+    T L = T(0.0);
+    for (int i = 0; i < 4; ++i) L += 0.5 * v(i) * v(i) + cos(q(i));
+    return L;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("without a declared constant mass matrix the shooting construction's lagrangian form integrates (q, v) "
+          "with the acceleration M^{-1} (L_q - L_vq v) at jets, the hamiltonian form and the one-step construction "
+          "(q, p) through the exact inverse Legendre transform, each giving the declared-mass trajectory to "
+          "round-off, and the lagrangian form refused where L's Hessian at jets is out of reach") {
+  Pendulum pendulum;  // declares no mass matrix
   SeparablePendulum declared;
   auto rule = simpson();
   auto method = rk4();
   FlatSpace space(1);
-  CHECK_THROWS_AS(ShootingDiscreteLagrangian(space, pendulum, rule, method, ShootingForm::lagrangian, {}),
-                  std::invalid_argument);
   CHECK_THROWS_AS(shooting_form("type-3"), std::invalid_argument);
   const auto final_state = [](DiscreteHamiltonianMap& map) {
     return run(map, Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Constant(1, 0.5), 0.1, 50);
   };
-  ShootingDiscreteLagrangian general(space, pendulum, rule, method, ShootingForm::hamiltonian, {});
-  ShootingDiscreteLagrangian constant(space, declared, rule, method, ShootingForm::hamiltonian, {});
-  const Eigen::VectorXd a = final_state(general), b = final_state(constant);
-  CAPTURE(a.transpose());
-  CAPTURE(b.transpose());
-  CHECK((a - b).lpNorm<Eigen::Infinity>() < 1e-13);
+  for (ShootingForm form : {ShootingForm::lagrangian, ShootingForm::hamiltonian}) {
+    ShootingDiscreteLagrangian general(space, pendulum, rule, method, form, {});
+    ShootingDiscreteLagrangian constant(space, declared, rule, method, form, {});
+    const Eigen::VectorXd a = final_state(general), b = final_state(constant);
+    CAPTURE(a.transpose());
+    CAPTURE(b.transpose());
+    CHECK((a - b).lpNorm<Eigen::Infinity>() < 1e-13);
+  }
   auto gauss = gauss2();
   OneStepHamiltonianMap general_one_step(space, pendulum, gauss, {}), constant_one_step(space, declared, gauss, {});
   const Eigen::VectorXd c = final_state(general_one_step), d = final_state(constant_one_step);
   CHECK((c - d).lpNorm<Eigen::Infinity>() < 1e-13);
+  FourPendulums four;
+  FlatSpace space4(4);
+  std::string message;
+  try {
+    ShootingDiscreteLagrangian refused(space4, four, rule, method, ShootingForm::lagrangian, {});
+  } catch (const std::invalid_argument& e) {
+    message = e.what();
+  }
+  CHECK(message.find("Hessian at jets of 8 variables") != std::string::npos);
+  CHECK(message.find("at most 6 variables") != std::string::npos);
+  CHECK_NOTHROW(ShootingDiscreteLagrangian(space4, four, rule, method, ShootingForm::hamiltonian, {}));
 }
 
 TEST_CASE("the one-step construction: MID is order 2, SRK4 (2-stage Gauss) order 4") {

@@ -80,3 +80,60 @@ TEST_CASE("an implicit method at jets carries the exact derivatives of its step"
     }
   }
 }
+
+namespace {
+
+// The double pendulum (unit masses and lengths): L = v1^2 + 1/2 v2^2 + v1 v2 cos(q1 - q2) + 2 cos q1
+// + cos q2, a configuration-dependent mass matrix, declared as none.
+struct DoublePendulum : sdk::AutodiffLagrangian<DoublePendulum> {
+  DoublePendulum() : sdk::AutodiffLagrangian<DoublePendulum>(2, 2) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::cos;
+    return v(0) * v(0) + 0.5 * v(1) * v(1) + v(0) * v(1) * cos(q(0) - q(1)) + 2.0 * cos(q(0)) + cos(q(1));
+  }
+};
+
+}  // namespace
+
+TEST_CASE("the tangent field (q, v) of a configuration-dependent mass matrix: its Jacobian and its jets' second "
+          "derivatives pass Taylor tests against the field's own values (issue #18: the lagrangian form of "
+          "shooting for the double pendulum)") {
+  DoublePendulum pendulum;
+  LagrangianEvaluator evaluator(pendulum);
+  MechanicalField field(evaluator, PhaseSpace::tangent);
+  const Eigen::Vector4d y(0.7, -0.4, 0.3, -1.1), d(0.3, -0.8, 0.5, 0.6);
+  Eigen::Vector4d f, f_step;
+  Eigen::Matrix4d J, J_step;
+  REQUIRE(field.jacobian(y.data(), f.data(), J.data()) == nullptr);
+  Eigen::Vector4d f_eval;
+  REQUIRE(field.eval(y.data(), f_eval.data()) == nullptr);
+  CHECK((f - f_eval).lpNorm<Eigen::Infinity>() < 1e-15);
+  // The field at jets along the line y + s d (one variable s): value, first and second derivative.
+  Jet2 line[4], rate[4];
+  const Jet2 s = Jet2::variable(0.0, 1, 0);
+  for (int r = 0; r < 4; ++r) line[r] = y[r] + d[r] * s;
+  REQUIRE(field.eval(line, rate) == nullptr);
+  Eigen::Vector4d second;
+  for (int r = 0; r < 4; ++r) {
+    CHECK(rate[r].value == doctest::Approx(f[r]).epsilon(1e-15));
+    CHECK(rate[r].gradient(0) == doctest::Approx((J * d)[r]).epsilon(1e-13));
+    second[r] = rate[r].hessian(0, 0);
+  }
+  // Taylor: f(y + e d) - f - e J d = O(e^2), and J(y + e d) d - J d - e f'' = O(e^2): halving e
+  // quarters both remainders.
+  double previous_value = 0.0, previous_slope = 0.0;
+  for (double e : {1e-2, 5e-3, 2.5e-3}) {
+    const Eigen::Vector4d moved = y + e * d;
+    REQUIRE(field.jacobian(moved.data(), f_step.data(), J_step.data()) == nullptr);
+    const double value_remainder = (f_step - f - e * J * d).norm();
+    const double slope_remainder = (J_step * d - J * d - e * second).norm();
+    CAPTURE(e);
+    if (previous_value > 0.0) {
+      CHECK(previous_value / value_remainder == doctest::Approx(4.0).epsilon(0.05));
+      CHECK(previous_slope / slope_remainder == doctest::Approx(4.0).epsilon(0.05));
+    }
+    previous_value = value_remainder;
+    previous_slope = slope_remainder;
+  }
+}

@@ -137,6 +137,17 @@ struct Coupled : varia::sdk::AutodiffLagrangian<Coupled> {
     const T s = sin(q[0] - q[1]), c = cos(q[0] - q[1]);
     return {-(v[0] * v[1] * s) - sin(q[0]), v[0] * v[1] * s, v[0] + v[1] * c, v[1] + v[0] * c};
   }
+  // Column-major in z = (q1, q2, v1, v2) (symmetric).
+  template <class T>
+  static std::vector<T> hessian(const T* q, const T* v) {
+    using std::cos;
+    using std::sin;
+    const T s = sin(q[0] - q[1]), c = cos(q[0] - q[1]), w = v[0] * v[1] * c;
+    return {-w - cos(q[0]), w,         -(v[1] * s), -(v[0] * s),  //
+            w,              -w,        v[1] * s,    v[0] * s,     //
+            -(v[1] * s),    v[1] * s,  T(1.0),      c,            //
+            -(v[0] * s),    v[0] * s,  c,           T(1.0)};
+  }
 };
 struct Single : varia::sdk::AutodiffLagrangian<Single> {
   Single() : varia::sdk::AutodiffLagrangian<Single>(1, 1) {}
@@ -152,6 +163,13 @@ struct Single : varia::sdk::AutodiffLagrangian<Single> {
     using std::sin;
     return {0.5 * v[0] * v[0] * cos(q[0]) - sin(q[0]), v[0] * (2.0 + sin(q[0]))};
   }
+  template <class T>
+  static std::vector<T> hessian(const T* q, const T* v) {
+    using std::cos;
+    using std::sin;
+    const T qv = v[0] * cos(q[0]);
+    return {-(0.5 * v[0] * v[0] * sin(q[0])) - cos(q[0]), qv, qv, 2.0 + sin(q[0])};
+  }
 };
 
 // The largest difference of two jets of N variables (a constant's derivatives are zero).
@@ -162,16 +180,21 @@ double jet_distance(const varia::Jet2& a, const varia::Jet2& b, int N) {
                    (hessian(a) - hessian(b)).cwiseAbs().maxCoeff()});
 }
 
-// Inputs that are nonlinear functions of `variables` jet variables (so that their Hessians are not
-// zero), the last one a constant.
-template <class Model>
-double jet_deviation(int variables) {
-  Model model;
-  const int m = model.position_size(), k = m + model.velocity_size(), N = variables;
+// k inputs that are nonlinear functions of N jet variables (so that their Hessians are not zero),
+// the last one a constant.
+std::vector<varia::Jet2> jet_inputs(int k, int N) {
   std::vector<varia::Jet2> x, z;
   for (int i = 0; i < N; ++i) x.push_back(varia::Jet2::variable(0.3 + 0.2 * i, N, i));
   for (int i = 0; i < k; ++i)
     z.push_back(i == k - 1 ? varia::Jet2(0.7) : sin(x[i % N] * x[(i + 1) % N]) + 0.5 * x[(i + 2) % N] * x[(i + 2) % N]);
+  return z;
+}
+
+template <class Model>
+double jet_deviation(int variables) {
+  Model model;
+  const int m = model.position_size(), k = m + model.velocity_size(), N = variables;
+  const std::vector<varia::Jet2> z = jet_inputs(k, N);
   std::vector<varia::Jet2> gradient(k);
   varia::Jet2 value;
   REQUIRE(model.gradient_jet(z.data(), z.data() + m, &value, gradient.data()) == nullptr);
@@ -193,5 +216,51 @@ TEST_CASE("gradient_jet at jets of 2, 4 and 6 variables (dual numbers over fixed
     CAPTURE(variables);
     CHECK(jet_deviation<Single>(variables) < 1e-14);
     CHECK(jet_deviation<Coupled>(variables) < 1e-14);
+  }
+}
+
+namespace {
+
+// The largest difference between L's Hessian at jets of N variables (hessian_jet) and jet
+// arithmetic on the written-out Hessian.
+template <class Model>
+double hessian_jet_deviation(int N) {
+  Model model;
+  const int m = model.position_size(), k = m + model.velocity_size();
+  const std::vector<varia::Jet2> z = jet_inputs(k, N);
+  std::vector<varia::Jet2> hessian(k * k);
+  REQUIRE(model.hessian_jet(z.data(), z.data() + m, hessian.data()) == nullptr);
+  const std::vector<varia::Jet2> expected = Model::hessian(z.data(), z.data() + m);
+  double worst = 0.0;
+  for (int i = 0; i < k * k; ++i) worst = std::max(worst, jet_distance(hessian[i], expected[i], N));
+  return worst;
+}
+
+}  // namespace
+
+TEST_CASE("hessian_jet at jets of 1 to 6 variables (forward over forward mode with jet values) equals jet "
+          "arithmetic on the written-out Hessian, and more are refused with the limit (issue #18: the lagrangian form "
+          "of shooting with a configuration-dependent mass matrix)") {
+  for (int variables = 1; variables <= 6; ++variables) {
+    CAPTURE(variables);
+    CHECK(hessian_jet_deviation<Single>(variables) < 1e-14);
+    CHECK(hessian_jet_deviation<Coupled>(variables) < 1e-14);
+  }
+  Coupled model;
+  CHECK(model.hessian_jet_variables() == 6);
+  std::vector<varia::Jet2> hessian(16);
+  const std::vector<varia::Jet2> z = jet_inputs(4, 7);
+  const varia::Status status = model.hessian_jet(z.data(), z.data() + 2, hessian.data());
+  REQUIRE(status != nullptr);
+  CHECK(std::string(status) == "an autodiff Lagrangian gives its Hessian at jets of at most 6 variables (a shooting "
+                               "step on R^1..R^3)");
+  // Constant inputs: the Hessian at doubles.
+  const std::vector<varia::Jet2> constants(4, varia::Jet2(0.4));
+  REQUIRE(model.hessian_jet(constants.data(), constants.data() + 2, hessian.data()) == nullptr);
+  const std::vector<double> at(4, 0.4);
+  const std::vector<double> expected = Coupled::hessian(at.data(), at.data() + 2);
+  for (int i = 0; i < 16; ++i) {
+    CHECK(hessian[i].constant());
+    CHECK(hessian[i].value == doctest::Approx(expected[i]).epsilon(1e-15));
   }
 }

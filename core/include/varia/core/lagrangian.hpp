@@ -37,6 +37,17 @@ class Lagrangian : public PluginObject {
   // Whether gradient_jet is implemented: constructions that need it refuse the Lagrangian when
   // they are built (`validate`, exit 2) rather than at the first step.
   virtual bool evaluates_at_jets() const noexcept { return false; }
+  // L's Hessian in z = (q, v) at jet inputs: the (m+n)^2 jets of d2L/dz dz (q(x), v(x)), dense,
+  // column-major, for jets of at most hessian_jet_variables() variables. The shooting construction's
+  // lagrangian form integrates the Euler-Lagrange field in (q, v) with it when the mass matrix
+  // L_vv depends on (q, v): the acceleration M^{-1} (L_q - L_vq v) and its second-order jets need
+  // L's derivatives to fourth order. The SDK's AutodiffLagrangian implements it for every model.
+  virtual Status hessian_jet(const Jet2* /*q*/, const Jet2* /*v*/, Jet2* /*hessian*/) noexcept {
+    return "this Lagrangian does not give its Hessian at jets (derive it from sdk::AutodiffLagrangian)";
+  }
+  // The most jet variables hessian_jet takes (0: not implemented); constructions refuse a larger
+  // need when they are built.
+  virtual int hessian_jet_variables() const noexcept { return 0; }
 
   // The declared symmetry (Noether): a group name ("none", "SO(2)", "SO(3)", ...), the size of
   // its momentum map J(q, v) = <dL/dv, xi_Q(q)>, and the lifted action of a pseudo-random group

@@ -1,7 +1,8 @@
 // The vector field that a one-step method integrates for the shooting construction (paper,
 // sec. 3) and the one-step construction, on R^n:
-//   tangent form (q, v):    q' = v,        v' = M^{-1} dL/dq (q, v)   (Euler-Lagrange, for a
-//                           Lagrangian L = 1/2 v^T M v - V(q) with a constant mass matrix M),
+//   tangent form (q, v):    q' = v,        v' = M^{-1} (dL/dq - d2L/dv dq v)   (Euler-Lagrange,
+//                           M = d2L/dv2 (q, v); for L = 1/2 v^T M v - V(q) with a constant mass
+//                           matrix, v' = M^{-1} dL/dq),
 //   cotangent form (q, p):  q' = v(q, p),  p' = dL/dq (q, v(q, p))    (Hamilton's equations of
 //                           the Legendre transform H(q, p) = <p, v> - L(q, v), dL/dv (q, v) = p,
 //                           paper, sec. 3 "Generalizations"), for any regular Lagrangian: v(q, p)
@@ -9,8 +10,8 @@
 //                           transform, solved by Newton's method at doubles and at jets.
 // The cotangent form needs L's derivatives to second order for the field's Jacobian and to third
 // order for its second-order jets, which dL/dv at jets gives; the tangent form of a
-// configuration-dependent mass matrix would need L's Hessian at jets, which the Lagrangian
-// interface does not give, and is refused.
+// configuration-dependent mass matrix needs them to third and fourth order, which L's Hessian at
+// jets gives (Lagrangian::hessian_jet; refused for a Lagrangian without it).
 // With forces f(t, q, v) (force.hpp) the field is that of the forced Euler-Lagrange equations,
 // d/dt dL/dv - dL/dq = f (Marsden & West 2001, sec. 3.2): M v' = L_q + f, or p' = L_q + f; the
 // time is then the state's last number, t' = 1 (the methods integrate autonomous fields).
@@ -96,7 +97,8 @@ class EulerLagrangeField : public VectorField {
 class MechanicalField final : public EulerLagrangeField {
  public:
   // The tangent form throws std::invalid_argument unless the Lagrangian declares a constant mass
-  // matrix. The forces (may be null or empty: none) are applied while forced() is on.
+  // matrix or gives its Hessian at jets of 2n variables. The forces (may be null or empty: none)
+  // are applied while forced() is on.
   MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space, Forces* forces = nullptr);
   int size() const noexcept override { return 2 * n_ + (clock() ? 1 : 0); }
   Status eval(const double* y, double* f) noexcept override;
@@ -108,6 +110,11 @@ class MechanicalField final : public EulerLagrangeField {
   void velocity(const Jet2* y, Jet2* v);
   // p = dL/dv (q, v) at doubles: the momentum of a velocity (a Newton guess on the cotangent side).
   void momentum(const double* q, const double* v, double* p);
+  // v(q, p) at doubles, the inverse: M^{-1} p, or the exact inverse Legendre transform.
+  void velocity_of(const double* q, const double* p, double* v) {
+    velocity_of_momentum(q, p);
+    Eigen::Map<Eigen::VectorXd>(v, n_) = v_;
+  }
 
   // The state's positions as offsets from `origin` (n jets, kept by the caller; null: none): the
   // field is evaluated at origin + offset. Every Runge-Kutta method commutes with the translation,
@@ -127,6 +134,13 @@ class MechanicalField final : public EulerLagrangeField {
   void force(const Jet2* y, const Jet2* v, Jet2* f);
 
  private:
+  // f(t, q, v) at jets q, v.
+  void force_at(const Jet2* q, const Jet2* v, double t, Jet2* f);
+  // The tangent form with a configuration-dependent mass matrix.
+  bool general_tangent() const { return space_ == PhaseSpace::tangent && !constant_mass_; }
+  void acceleration(double* a);
+  void acceleration(const Jet2* q, const Jet2* v, Jet2* a);
+  void general_tangent_jacobian(const double* y, double* f, double* df);
   // Adds the forces at the values of y (velocity v_) to gradient_.head(n) (= L_q + f), and with
   // `jacobian` their Jacobian to the rows of hessian_ (d(L_q + f)/d(q, v)).
   void add_forces(const double* y, const double* q, bool jacobian);
@@ -147,9 +161,13 @@ class MechanicalField final : public EulerLagrangeField {
   std::vector<Jet2> force_jet_;
   // Workspace, sized once.
   Eigen::VectorXd v_, gradient_;
-  Eigen::MatrixXd hessian_, velocity_q_;  // velocity_q_: v_q in cotangent_jacobian(), M^{-1} in velocity()
+  Eigen::MatrixXd hessian_, velocity_q_;  // v_q in cotangent_jacobian(), M^{-1} in velocity(), M in acceleration()
+  Eigen::MatrixXd inverse_mass_at_;  // M^{-1} at the values, for the acceleration at jets
+  Eigen::MatrixXd identity_;
+  Eigen::VectorXd rhs_;
   Eigen::PartialPivLU<Eigen::MatrixXd> mass_lu_;  // L_vv at the last state (not constant_mass())
-  std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;
+  std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;  // the last also acceleration()'s right side, residual
+  std::vector<Jet2> hessian_jet_, seed_, acceleration_jet_;
   SolverOptions legendre_options_;
 };
 

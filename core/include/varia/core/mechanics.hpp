@@ -39,6 +39,8 @@ class LagrangianEvaluator {
   // L (if value is not null) and its m + n gradient numbers at jet inputs. Counted as a Hessian
   // evaluation: it carries second-order information.
   void gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient);
+  // L's (m+n)^2 Hessian numbers at jet inputs, dense column-major. Counted as a Hessian evaluation.
+  void hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian);
   const EvaluationCounters& counters() const { return counters_; }
 
   // p = dL/dv (q, v).

@@ -16,8 +16,9 @@ namespace varia {
 // Lie group hooks (algebra, move); 5: Manifold::chart_jets, Manifold::local_jets; 6: the chart's
 // derivatives as caller-sized arrays (Manifold::chart, Manifold::local_derivatives, replacing the
 // jets), Manifold::has_constraint, Lagrangian::evaluates_at_jets, PluginObject::origin;
-// 7: Manifold::translate, Manifold::generators; 9: Manifold::has_increment, Manifold::increment.
-inline constexpr int kAbiVersion = 9;
+// 7: Manifold::translate, Manifold::generators; 9: Manifold::has_increment, Manifold::increment;
+// 10: Lagrangian::hessian_jet, Lagrangian::hessian_jet_variables.
+inline constexpr int kAbiVersion = 10;
 
 using Status = const char*;
 

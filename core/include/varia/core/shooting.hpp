@@ -54,8 +54,9 @@
 // quadratures there.
 //
 // Restrictions: a manifold of dimension n <= 6 (jets of 2n <= kMaxJetVariables = 12 variables:
-// SE(3)); the lagrangian form needs a Lagrangian with a constant mass matrix, the hamiltonian and
-// type-2 forms take any regular one (mechanical_field.hpp).
+// SE(3)); the lagrangian form with a configuration-dependent mass matrix needs L's Hessian at jets
+// of 2n variables (the SDK gives it on R^1..R^3), the hamiltonian and type-2 forms take any
+// regular Lagrangian (mechanical_field.hpp).
 #pragma once
 
 #include <Eigen/Core>

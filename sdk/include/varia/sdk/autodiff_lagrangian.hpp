@@ -15,7 +15,9 @@
 // TermwiseLagrangian (termwise_lagrangian.hpp): linear cost and a sparse Hessian. The same model,
 // evaluated at dual numbers over second-order jets (kJetDirections derivative directions at a
 // time), gives gradient_jet, for up to kStackVariables numbers (the shooting construction's jets
-// hold fewer variables than that).
+// hold fewer variables than that). Forward mode over forward mode at jet values (jet_tangent.hpp)
+// gives hessian_jet at jets of up to 6 variables, which the shooting construction's lagrangian
+// form needs for a configuration-dependent mass matrix on R^1..R^3.
 #pragma once
 
 #include <Eigen/Core>
@@ -27,6 +29,7 @@
 
 #include "varia/core/lagrangian.hpp"
 #include "varia/sdk/dual.hpp"
+#include "varia/sdk/jet_tangent.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::sdk {
@@ -82,6 +85,21 @@ class AutodiffLagrangian : public Lagrangian {
         case 6: return at_fixed_jets<6>(q, v, value, gradient);
         default: return at_jets(q, v, value, gradient);
       }
+    });
+  }
+  int hessian_jet_variables() const noexcept final { return m_ + n_ <= kStackVariables ? kMaxHessianJetVariables : 0; }
+  Status hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian) noexcept final {
+    return guarded(error_, [&] {
+      if (m_ + n_ > kStackVariables)
+        throw std::length_error("an autodiff Lagrangian gives its Hessian at jets for at most " +
+                                std::to_string(kStackVariables) + " position and velocity numbers together");
+      const int variables = jet_variables(q, v);
+      if (variables == 0) return hessian_at_constants(q, v, hessian);
+      if (variables <= 2) return hessian_at_fixed_jets<2>(q, v, variables, hessian);
+      if (variables <= 4) return hessian_at_fixed_jets<4>(q, v, variables, hessian);
+      if (variables <= kMaxHessianJetVariables) return hessian_at_fixed_jets<6>(q, v, variables, hessian);
+      throw std::length_error("an autodiff Lagrangian gives its Hessian at jets of at most " +
+                              std::to_string(kMaxHessianJetVariables) + " variables (a shooting step on R^1..R^3)");
     });
   }
 
@@ -194,6 +212,59 @@ class AutodiffLagrangian : public Lagrangian {
     const JD r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value();
     for (int i = first; i < last; ++i) gradient[i] = derivative(r, i - first);
+  }
+
+  // L's Hessian at jets of `variables` <= N variables (held as FixedJet<N>, padded with zero
+  // derivatives): forward over forward mode with jet values, the outer level
+  // Eigen's AutoDiffScalar, the inner a JetTangent (jet_tangent.hpp), kHessianJetDirections
+  // directions each: one pass of the model per pair of blocks (a, b), b >= a, whose second
+  // derivatives give H(a.., b..) and, by symmetry, H(b.., a..).
+  template <int N>
+  void hessian_at_fixed_jets(const Jet2* q, const Jet2* v, int variables, Jet2* hessian) const {
+    constexpr int K = kHessianJetDirections;
+    using Inner = JetTangent<FixedJet<N>, K>;
+    using Outer = Eigen::AutoDiffScalar<Eigen::Matrix<Inner, K, 1>>;
+    const int k = m_ + n_;
+    std::array<FixedJet<N>, kStackVariables> z;
+    for (int i = 0; i < k; ++i) {
+      const Jet2& x = at(q, v, m_, i);
+      z[i] = FixedJet<N>(x.value);
+      if (x.constant()) continue;
+      z[i].gradient.head(variables) = x.gradient;
+      z[i].hessian.topLeftCorner(variables, variables) = x.hessian;
+    }
+    Vec<Outer> qd(m_), vd(n_);
+    for (int a = 0; a < k; a += K)
+      for (int b = a; b < k; b += K) {
+        for (int i = 0; i < k; ++i) {
+          Outer& x = input(qd, vd, i);
+          x.value() = Inner(z[i]);
+          if (i >= b && i < b + K) x.value().derivatives[i - b] = FixedJet<N>(1.0);
+          for (int j = 0; j < K; ++j) x.derivatives()(j) = Inner(i == a + j ? 1.0 : 0.0);
+        }
+        const Outer r = model().lagrangian(qd, vd);
+        for (int j = 0; j < K && a + j < k; ++j)
+          for (int i = 0; i < K && b + i < k; ++i)
+            hessian[(a + j) * k + b + i] = hessian[(b + i) * k + a + j] =
+                truncated(r.derivatives()(j).derivatives[i], variables);
+      }
+  }
+  template <int N>
+  static Jet2 truncated(const FixedJet<N>& x, int variables) {
+    Jet2 jet(x.value);
+    jet.gradient = x.gradient.head(variables);
+    jet.hessian = x.hessian.topLeftCorner(variables, variables);
+    return jet;
+  }
+  // Constant inputs: the Hessian at their values, as constant jets.
+  void hessian_at_constants(const Jet2* q, const Jet2* v, Jet2* hessian) {
+    const int k = m_ + n_;
+    for (int i = 0; i < k; ++i) input(q_, v_, i) = at(q, v, m_, i).value;
+    std::array<double, kStackVariables * kStackVariables> values;
+    dispatch([&](auto, auto second, auto) {
+      second_order<typename decltype(second)::type>(q_.data(), v_.data(), nullptr, nullptr, values.data());
+    });
+    for (int i = 0; i < k * k; ++i) hessian[i] = Jet2(values[i]);
   }
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).

@@ -27,6 +27,11 @@ inline constexpr int kChunkDirections = 8;
 // (q, v) at a time, one evaluation per block: a dual number over jets then holds 1 + 4 jets, and
 // a Vec of them (18 x 5 x 1.3 kB) stays within Eigen's stack allocation limit (128 kB).
 inline constexpr int kJetDirections = 4;
+// L's Hessian at jet inputs (Lagrangian::hessian_jet) is taken kHessianJetDirections by
+// kHessianJetDirections numbers of (q, v) at a time, at jets of up to kMaxHessianJetVariables
+// variables (FixedJet: a second-order scalar over FixedJet<6> holds 9 x 43 doubles).
+inline constexpr int kHessianJetDirections = 2;
+inline constexpr int kMaxHessianJetVariables = 6;
 
 // A vector of at most `Capacity` numbers, stored in place.
 template <class T, int Capacity>
