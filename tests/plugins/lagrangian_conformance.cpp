@@ -323,3 +323,62 @@ TEST_CASE(
     CHECK(std::string(status).find("bound orbits only") != std::string::npos);
   }
 }
+
+namespace {
+
+// Forwards to `inner`, but its gradient or its Hessian at jets carries first derivatives 1.5
+// times too large (the values right): what the suite's Taylor tests at jets must refuse.
+class LyingJets final : public Lagrangian {
+ public:
+  LyingJets(Lagrangian& inner, bool in_hessian) : inner_(inner), in_hessian_(in_hessian) {}
+  int position_size() const noexcept override { return inner_.position_size(); }
+  int velocity_size() const noexcept override { return inner_.velocity_size(); }
+  varia::Status evaluate(const double* q, const double* v, double* value, double* gradient,
+                         double* hessian) noexcept override {
+    return inner_.evaluate(q, v, value, gradient, hessian);
+  }
+  bool evaluates_at_jets() const noexcept override { return true; }
+  varia::Status gradient_jet(const varia::Jet2* q, const varia::Jet2* v, varia::Jet2* value,
+                             varia::Jet2* gradient) noexcept override {
+    const varia::Status status = inner_.gradient_jet(q, v, value, gradient);
+    if (status == nullptr && !in_hessian_) scale(gradient, size());
+    return status;
+  }
+  int hessian_jet_variables() const noexcept override { return inner_.hessian_jet_variables(); }
+  varia::Status hessian_jet(const varia::Jet2* q, const varia::Jet2* v, varia::Jet2* hessian) noexcept override {
+    const varia::Status status = inner_.hessian_jet(q, v, hessian);
+    if (status == nullptr && in_hessian_) scale(hessian, size() * size());
+    return status;
+  }
+
+ private:
+  int size() const { return position_size() + velocity_size(); }
+  static void scale(varia::Jet2* x, int count) {
+    for (int i = 0; i < count; ++i)
+      if (!x[i].constant()) x[i].gradient *= 1.5;
+  }
+  Lagrangian& inner_;
+  bool in_hessian_;
+};
+
+}  // namespace
+
+TEST_CASE("the Lagrangian suite checks the gradient and the Hessian at jets by Taylor tests: the double pendulum "
+          "conforms, and the same plugin with first derivatives of either 1.5 times too large is refused") {
+  const auto pendulum = make("double_pendulum", Json::object(), rn(2));
+  REQUIRE(pendulum->hessian_jet_variables() == 6);
+  std::mt19937 engine(11);
+  CHECK(varia::sdk::conformance::check_lagrangian(*pendulum, engine).empty());
+  for (bool in_hessian : {false, true}) {
+    CAPTURE(in_hessian);
+    LyingJets lying(*pendulum, in_hessian);
+    const varia::sdk::conformance::Failures failures = varia::sdk::conformance::check_lagrangian(lying, engine);
+    REQUIRE_FALSE(failures.empty());
+    std::string report;
+    for (const std::string& line : failures.list()) report += line + "\n";
+    MESSAGE(report);
+    CHECK(report.find(in_hessian ? "the Hessian at jets: the first derivative" : "the gradient at jets: the first derivative") !=
+          std::string::npos);
+    CHECK(report.find("falls as eps^1") != std::string::npos);
+  }
+}

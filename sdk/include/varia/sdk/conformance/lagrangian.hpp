@@ -1,7 +1,9 @@
 // The Lagrangian conformance suite: at random points (q, v), the gradient and Hessian a plugin
 // returns match central differences of its value and gradient; the Hessian is symmetric; every
 // evaluate() path gives the same value; a declared constant mass matrix is the Hessian's velocity
-// block; a declared symmetry leaves L invariant and its momentum map is equivariant.
+// block; a declared symmetry leaves L invariant and its momentum map is equivariant; L's gradient
+// and Hessian at jets (gradient_jet, hessian_jet, where the Lagrangian gives them) carry the values
+// at doubles and derivatives that pass Taylor tests against them.
 #pragma once
 
 #include <Eigen/Dense>
@@ -9,7 +11,9 @@
 #include <cmath>
 #include <random>
 #include <sstream>
+#include <string>
 #include <utility>
+#include <vector>
 
 #include "varia/core/lagrangian.hpp"
 #include "varia/sdk/conformance/failures.hpp"
@@ -99,6 +103,74 @@ inline void check_symmetry(Lagrangian& lagrangian, unsigned seed, const VectorXd
                   " differs from |J(q, v)| = ", j.norm(), " (Ad*-equivariance)");
 }
 
+// Jets along the line z + s d at s = eps, one jet variable s: value z + eps d, derivative d.
+inline std::vector<Jet2> line_jets(const VectorXd& z, const VectorXd& d, double eps) {
+  std::vector<Jet2> x;
+  const Jet2 s = Jet2::variable(0.0, 1, 0);
+  for (Eigen::Index i = 0; i < z.size(); ++i) x.push_back(d(i) * s + (z(i) + eps * d(i)));
+  return x;
+}
+// The values (order 0), first or second derivatives along the line of jets.
+inline VectorXd jet_part(const std::vector<Jet2>& jets, int order) {
+  VectorXd x(static_cast<Eigen::Index>(jets.size()));
+  for (std::size_t i = 0; i < jets.size(); ++i) {
+    const Jet2& j = jets[i];
+    x(static_cast<Eigen::Index>(i)) = order == 0 ? j.value : j.constant() ? 0.0 : order == 1 ? j.gradient(0) : j.hessian(0, 0);
+  }
+  return x;
+}
+// A quantity at jets, jets(eps) along the line z + s d, against the same at doubles, doubles(eps)
+// at z + eps d: the values agree, the first derivative passes the Taylor test against the values at
+// doubles, and the second against the first derivative at z + eps d.
+template <class Jets, class Doubles>
+void check_at_jets(Jets&& jets, Doubles&& doubles, const std::string& what, Failures& failures) {
+  const std::vector<Jet2> at = jets(0.0);
+  const VectorXd values = doubles(0.0), first = jet_part(at, 1), second = jet_part(at, 2);
+  const double scale = std::max(1.0, values.cwiseAbs().maxCoeff());
+  const double gap = (jet_part(at, 0) - values).cwiseAbs().maxCoeff();
+  failures.expect(gap <= 1e-13 * scale, what, " at jets: its values differ from those at doubles by ", gap);
+  expect_taylor(
+      failures, [&](double eps) { return (doubles(eps) - values - eps * first).norm(); }, scale,
+      what + " at jets: the first derivative");
+  expect_taylor(
+      failures, [&](double eps) { return (jet_part(jets(eps), 1) - first - eps * second).norm(); },
+      std::max(1.0, first.cwiseAbs().maxCoeff()), what + " at jets: the second derivative");
+}
+
+// gradient_jet and hessian_jet (where given) along a random line through (q, v).
+inline void check_jets(Lagrangian& lagrangian, unsigned seed, const VectorXd& q, const VectorXd& v,
+                       Failures& failures) {
+  const int m = lagrangian.position_size(), k = m + lagrangian.velocity_size();
+  VectorXd z(k);
+  z << q, v;
+  std::mt19937 engine(seed);
+  const VectorXd d = random_direction(k, engine);
+  const auto at_doubles = [&](double eps) {
+    const VectorXd moved = z + eps * d;
+    return evaluate(lagrangian, moved.head(m), moved.tail(k - m));
+  };
+  if (lagrangian.evaluates_at_jets())
+    check_at_jets(
+        [&](double eps) {
+          const std::vector<Jet2> x = line_jets(z, d, eps);
+          std::vector<Jet2> gradient(k);
+          check(lagrangian, lagrangian.gradient_jet(x.data(), x.data() + m, nullptr, gradient.data()),
+                "Lagrangian gradient at jets");
+          return gradient;
+        },
+        [&](double eps) { return at_doubles(eps).gradient; }, "the gradient", failures);
+  if (lagrangian.hessian_jet_variables() >= 1)
+    check_at_jets(
+        [&](double eps) {
+          const std::vector<Jet2> x = line_jets(z, d, eps);
+          std::vector<Jet2> hessian(k * k);
+          check(lagrangian, lagrangian.hessian_jet(x.data(), x.data() + m, hessian.data()),
+                "Lagrangian Hessian at jets");
+          return hessian;
+        },
+        [&](double eps) { return at_doubles(eps).hessian.reshaped().eval(); }, "the Hessian", failures);
+}
+
 // The claims at one point (q, v).
 inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q, const VectorXd& v,
                         Failures& failures) {
@@ -124,6 +196,7 @@ inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q
                     "a constant mass matrix is declared but d2L/dv dq is not zero");
   }
   if (lagrangian.momentum_size() > 0) check_symmetry(lagrangian, seed, q, v, e.value, failures);
+  check_jets(lagrangian, seed, q, v, failures);
 }
 
 // The whole suite on one Lagrangian, at `trials` random points.
