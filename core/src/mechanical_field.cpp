@@ -41,7 +41,6 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       gradient_(2 * n_),
       hessian_(2 * n_, 2 * n_),
       velocity_q_(n_, n_),
-      inverse_mass_at_(n_, n_),
       identity_(Eigen::MatrixXd::Identity(n_, n_)),
       rhs_(n_),
       mass_lu_(n_),
@@ -50,7 +49,8 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       legendre_residual_(2 * n_),
       hessian_jet_(4 * n_ * n_),
       seed_(2 * n_),
-      acceleration_jet_(n_) {
+      acceleration_jet_(n_),
+      correction_jet_(n_) {
   const int needed = 2 * n_, given = lagrangian.plugin().hessian_jet_variables();
   if (space == PhaseSpace::tangent && !constant_mass_ && given < needed)
     throw std::invalid_argument(
@@ -68,14 +68,21 @@ void EulerLagrangeField::inverse_mass(const double* w, double* x) const {
       inverse_mass_ * Eigen::Map<const Eigen::VectorXd>(w, n_);
 }
 
-void EulerLagrangeField::inverse_mass(const Jet2* w, Jet2* x) const {
-  for (int r = 0; r < n_; ++r) {
+namespace {
+
+// y = A x, A of doubles, x and y (distinct) of jets; A's zero entries are skipped.
+void multiply(const Eigen::MatrixXd& A, const Jet2* x, Jet2* y) {
+  for (Eigen::Index r = 0; r < A.rows(); ++r) {
     Jet2 sum;
-    for (int c = 0; c < n_; ++c)
-      if (inverse_mass_(r, c) != 0.0) sum += inverse_mass_(r, c) * w[c];
-    x[r] = sum;
+    for (Eigen::Index c = 0; c < A.cols(); ++c)
+      if (A(r, c) != 0.0) sum += A(r, c) * x[c];
+    y[r] = sum;
   }
 }
+
+}  // namespace
+
+void EulerLagrangeField::inverse_mass(const Jet2* w, Jet2* x) const { multiply(inverse_mass_, w, x); }
 
 // v(q, p) at jets. With a constant mass matrix M^{-1} p; otherwise Newton's method at jets on
 // dL/dv (q, v) = p from the value v(q.value, p.value), with the constant matrix L_vv there: the
@@ -101,14 +108,8 @@ void MechanicalField::velocity(const Jet2* y, Jet2* v) {
   for (int iteration = 0; iteration < 2; ++iteration) {
     lagrangian_.gradient_jet(q, v, nullptr, legendre_residual_.data());
     for (int r = 0; r < n_; ++r) legendre_residual_[n_ + r] -= w[r];
-    for (int r = 0; r < n_; ++r) {
-      Jet2 update;
-      for (int c = 0; c < n_; ++c) {
-        const double a = velocity_q_(r, c);
-        if (a != 0.0) update += a * legendre_residual_[n_ + c];
-      }
-      v[r] -= update;
-    }
+    multiply(velocity_q_, legendre_residual_.data() + n_, correction_jet_.data());
+    for (int r = 0; r < n_; ++r) v[r] -= correction_jet_[r];
   }
 }
 
@@ -267,22 +268,18 @@ void MechanicalField::acceleration(const Jet2* q, const Jet2* v, Jet2* a) {
   for (int r = 0; r < n_; ++r) {
     Jet2& rhs = legendre_residual_[r] = gradient_jet_[r];
     for (int c = 0; c < n_; ++c) rhs -= H(n_ + r, c) * v[c];
-    for (int c = 0; c < n_; ++c) velocity_q_(r, c) = H(n_ + r, n_ + c).value;
+    for (int c = 0; c < n_; ++c) velocity_q_(r, c) = H(n_ + r, n_ + c).value;  // M at the values
   }
   mass_lu_.compute(velocity_q_);
-  inverse_mass_at_.noalias() = mass_lu_.solve(identity_);  // inverse() would allocate
-  const auto add_solution = [&](const Jet2* rhs) {
-    for (int r = 0; r < n_; ++r)
-      for (int c = 0; c < n_; ++c) a[r] += inverse_mass_at_(r, c) * rhs[c];
-  };
-  std::fill_n(a, n_, Jet2(0.0));
-  add_solution(legendre_residual_.data());
+  velocity_q_.noalias() = mass_lu_.solve(identity_);  // M^{-1} at the values (inverse() would allocate)
+  multiply(velocity_q_, legendre_residual_.data(), a);
   for (int iteration = 0; iteration < 2; ++iteration) {
     for (int r = 0; r < n_; ++r) {
       Jet2& residual = legendre_residual_[n_ + r] = legendre_residual_[r];
       for (int c = 0; c < n_; ++c) residual -= H(n_ + r, n_ + c) * a[c];
     }
-    add_solution(legendre_residual_.data() + n_);
+    multiply(velocity_q_, legendre_residual_.data() + n_, correction_jet_.data());
+    for (int r = 0; r < n_; ++r) a[r] += correction_jet_[r];
   }
 }
 

@@ -24,39 +24,6 @@ Eigen::VectorXd random_point(varia::Manifold& manifold, const Eigen::VectorXd& g
   return g;
 }
 
-// R under addition, embedded as (x, x^3): a Lie group whose composition (a, b) -> (a0 + b0,
-// (a0 + b0)^3) is not affine in b, so compose(q, e + E) - q is not the tangent vector.
-struct Cubic {
-  static constexpr int point_size = 2, dim = 1;
-  template <class T>
-  static void compose(const T* a, const T* b, T* ab) {
-    ab[0] = a[0] + b[0];
-    ab[1] = ab[0] * ab[0] * ab[0];
-  }
-  static void inverse(const double* a, double* a_inverse) {
-    a_inverse[0] = -a[0];
-    a_inverse[1] = -a[1];
-  }
-  template <class T>
-  static void exp(const T* xi, T* g) {
-    g[0] = xi[0];
-    g[1] = xi[0] * xi[0] * xi[0];
-  }
-  template <class T>
-  static void log(const T* g, T* xi) {
-    xi[0] = g[0];
-  }
-  template <class T>
-  static void bracket(const T*, const T*, T* ab) {
-    ab[0] = T(0.0);
-  }
-};
-
-class CubicLine final : public varia::sdk::LieGroupManifold<Cubic> {
- public:
-  bool contains(const double* q, char*, int) noexcept override { return std::abs(q[1] - q[0] * q[0] * q[0]) < 1e-12; }
-};
-
 // R under addition, a group the suite passes, whose chart then lies about its gradient away from
 // 0 when asked without the Hessian (a hand-written first-order path that went wrong).
 struct Line {
@@ -78,6 +45,31 @@ struct Line {
   static void bracket(const T*, const T*, T* ab) {
     ab[0] = T(0.0);
   }
+};
+
+// The same group embedded as (x, x^3): its composition (a, b) -> (a0 + b0, (a0 + b0)^3) is not
+// affine in b, so compose(q, e + E) - q is not the tangent vector. log and the bracket are Line's.
+struct Cubic : Line {
+  static constexpr int point_size = 2;
+  template <class T>
+  static void compose(const T* a, const T* b, T* ab) {
+    ab[0] = a[0] + b[0];
+    ab[1] = ab[0] * ab[0] * ab[0];
+  }
+  static void inverse(const double* a, double* a_inverse) {
+    a_inverse[0] = -a[0];
+    a_inverse[1] = -a[1];
+  }
+  template <class T>
+  static void exp(const T* xi, T* g) {
+    g[0] = xi[0];
+    g[1] = xi[0] * xi[0] * xi[0];
+  }
+};
+
+class CubicLine final : public varia::sdk::LieGroupManifold<Cubic> {
+ public:
+  bool contains(const double* q, char*, int) noexcept override { return std::abs(q[1] - q[0] * q[0] * q[0]) < 1e-12; }
 };
 
 class LyingLine final : public varia::sdk::LieGroupManifold<Line> {

@@ -161,13 +161,12 @@ class MechanicalField final : public EulerLagrangeField {
   std::vector<Jet2> force_jet_;
   // Workspace, sized once.
   Eigen::VectorXd v_, gradient_;
-  Eigen::MatrixXd hessian_, velocity_q_;  // v_q in cotangent_jacobian(), M^{-1} in velocity(), M in acceleration()
-  Eigen::MatrixXd inverse_mass_at_;  // M^{-1} at the values, for the acceleration at jets
+  Eigen::MatrixXd hessian_, velocity_q_;  // v_q in cotangent_jacobian(), M^{-1} at the values in velocity() and acceleration()
   Eigen::MatrixXd identity_;
   Eigen::VectorXd rhs_;
   Eigen::PartialPivLU<Eigen::MatrixXd> mass_lu_;  // L_vv at the last state (not constant_mass())
   std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;  // the last also acceleration()'s right side, residual
-  std::vector<Jet2> hessian_jet_, seed_, acceleration_jet_;
+  std::vector<Jet2> hessian_jet_, seed_, acceleration_jet_, correction_jet_;  // correction_jet_: M^{-1} times a residual
   SolverOptions legendre_options_;
 };
 
