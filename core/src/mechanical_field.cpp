@@ -1,6 +1,7 @@
 #include "varia/core/mechanical_field.hpp"
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 #include <string>
@@ -47,20 +48,24 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       v_jet_(n_),
       gradient_jet_(2 * n_),
       legendre_residual_(2 * n_),
-      hessian_jet_(4 * n_ * n_),
+      hessian_jet_(general_tangent() ? 4 * n_ * n_ : 0),  // only the general tangent form takes L's Hessian at jets
       seed_(2 * n_),
       acceleration_jet_(n_),
-      correction_jet_(n_) {
-  const int needed = 2 * n_, given = lagrangian.plugin().hessian_jet_variables();
-  if (space == PhaseSpace::tangent && !constant_mass_ && given < needed)
+      correction_jet_(n_),
+      hessian_jet_variables_(lagrangian.plugin().hessian_jet_variables()) {
+  if (general_tangent() && hessian_jet_variables_ < 2)
     throw std::invalid_argument(
         "the tangent form (q, v) of the Euler-Lagrange field with a configuration-dependent mass matrix needs "
-        "the Lagrangian's Hessian at jets of " + std::to_string(needed) + " variables (Lagrangian::hessian_jet: "
-        "the acceleration M^{-1} (L_q - L_vq v) and its second-order jets need L's derivatives to fourth order); "
-        "this one declares no constant mass matrix and gives its Hessian at jets of at most " +
-        std::to_string(given) + " variables (sdk::AutodiffLagrangian: 6, i.e. R^1..R^3). Integrate in (q, p): "
-        "the shooting construction's \"form\": \"hamiltonian\"");
+        "the Lagrangian's Hessian at jets of at least 2 variables (Lagrangian::hessian_jet: the acceleration "
+        "M^{-1} (L_q - L_vq v) and its second-order jets need L's derivatives to fourth order); this one declares "
+        "no constant mass matrix and gives no Hessian at jets (models derived from sdk::AutodiffLagrangian give "
+        "it on its fixed-size path, docs/shooting.md). Integrate in (q, p): the shooting construction's "
+        "\"form\": \"hamiltonian\"");
   v_.setZero();
+}
+
+int MechanicalField::jet_variables() const {
+  return general_tangent() ? std::min(kMaxJetVariables, hessian_jet_variables_) : kMaxJetVariables;
 }
 
 void EulerLagrangeField::inverse_mass(const double* w, double* x) const {
@@ -284,28 +289,37 @@ void MechanicalField::acceleration(const Jet2* q, const Jet2* v, Jet2* a) {
 }
 
 // The tangent form's Jacobian with a configuration-dependent mass matrix: the acceleration at jets
-// whose variables are (q, v) themselves (2n of them), read off their gradients; the forces enter
-// through their Jacobian (force_at), the time's column is zero as in jacobian().
+// whose variables are a block of (q, v)'s own numbers, read off their gradients, in blocks of at
+// most jet_variables() numbers; the forces enter through their Jacobian (force_at), the time's
+// column is zero as in jacobian().
 void MechanicalField::general_tangent_jacobian(const double* y, double* f, double* df) {
   const double* q = point(y);
-  for (int r = 0; r < n_; ++r) {
-    seed_[r] = Jet2::variable(q[r], 2 * n_, r);
-    v_jet_[r] = Jet2::variable(y[n_ + r], 2 * n_, n_ + r);
-  }
-  lagrangian_.gradient_jet(seed_.data(), v_jet_.data(), nullptr, gradient_jet_.data());
-  if (forced_) {
-    force_at(seed_.data(), v_jet_.data(), y[2 * n_], force_jet_.data());
-    for (int r = 0; r < n_; ++r) gradient_jet_[r] += force_jet_[r];
-  }
-  acceleration(seed_.data(), v_jet_.data(), acceleration_jet_.data());
-  const int N = size();
+  const int N = size(), block = jet_variables();
   Eigen::Map<Eigen::MatrixXd> J(df, N, N);
   J.setZero();
   J.block(0, n_, n_, n_).setIdentity();
+  for (int first = 0; first < 2 * n_; first += block) {
+    const int count = std::min(block, 2 * n_ - first);
+    const auto seeded = [&](double x, int index) {
+      return index >= first && index < first + count ? Jet2::variable(x, count, index - first) : Jet2(x);
+    };
+    for (int r = 0; r < n_; ++r) {
+      seed_[r] = seeded(q[r], r);
+      v_jet_[r] = seeded(y[n_ + r], n_ + r);
+    }
+    lagrangian_.gradient_jet(seed_.data(), v_jet_.data(), nullptr, gradient_jet_.data());
+    if (forced_) {
+      force_at(seed_.data(), v_jet_.data(), y[2 * n_], force_jet_.data());
+      for (int r = 0; r < n_; ++r) gradient_jet_[r] += force_jet_[r];
+    }
+    acceleration(seed_.data(), v_jet_.data(), acceleration_jet_.data());
+    for (int r = 0; r < n_; ++r)
+      if (!acceleration_jet_[r].constant())
+        J.row(n_ + r).segment(first, count) = acceleration_jet_[r].gradient.transpose();
+  }
   for (int r = 0; r < n_; ++r) {
     f[r] = y[n_ + r];
     f[n_ + r] = acceleration_jet_[r].value;
-    J.row(n_ + r).head(2 * n_) = acceleration_jet_[r].gradient.transpose();
   }
   if (clock()) f[2 * n_] = 1.0;
 }

@@ -24,10 +24,10 @@ Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingFo
     throw std::invalid_argument("the shooting construction propagates jets through the Euler-Lagrange field, and "
                                 "this Lagrangian does not evaluate at jets (models derived from "
                                 "sdk::AutodiffLagrangian do; the composite Lagrangian does not)");
-  if (2 * manifold.dim() > kMaxJetVariables)
-    throw std::invalid_argument("the shooting construction differentiates the propagation with "
+  if (!manifold.is_vector_space() && 2 * manifold.dim() > kMaxJetVariables)
+    throw std::invalid_argument("the shooting construction on a Lie group differentiates the propagation with "
                                 "jets of at most " + std::to_string(kMaxJetVariables) +
-                                " variables (eta, w0): it takes dim <= " +
+                                " variables (eta, w0) in one pass: it takes groups of dim <= " +
                                 std::to_string(kMaxJetVariables / 2));
   return lagrangian;
 }
@@ -108,7 +108,9 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   target_.resize(m_);
   force_.resize(n_);
   alpha_.resize(2 * n_);
-  work_jacobian_.resize(2 * n_, 2 * n_);
+  zero_.assign(std::max(m_, n_), 0.0);
+  slot_.resize(2 * n_);
+  plan_passes(field_->jet_variables());
   v_.resize(n_);
   acceleration_.resize(n_);
   gradient_.resize(m_ + n_);
@@ -140,6 +142,56 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   jacobian_.resize(n_, n_);
   BwT_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
   jacobian_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
+}
+
+// The passes of a propagation. When the jets hold all 2n numbers of x = (eta, w0), one pass gives
+// every derivative (R^1..R^6 and the Lie groups). Otherwise (R^n, n > capacity / 2), the first
+// derivatives come from passes over consecutive blocks of `capacity` numbers, and Phi's columns in
+// w0, the only second derivatives the solve needs (shooting.hpp), from passes over a block of
+// eta with a block of w0 and over two blocks of w0 (capacity / 2 numbers each): of the order of
+// (n / (capacity / 2))^2 propagations, each of jets of `capacity` variables, instead of one of
+// jets of 2n (2n + 4n^2 numbers each).
+void ShootingDiscreteLagrangian::plan_passes(int capacity) {
+  const int V = 2 * n_;
+  const auto block = [](int first, int count) {
+    std::vector<int> variables(count);
+    for (int j = 0; j < count; ++j) variables[j] = first + j;
+    return variables;
+  };
+  jet_size_ = std::min(V, capacity);  // every pass's jets alike: a method's workspace keeps its size
+  if (V <= capacity) {
+    passes_.push_back({block(0, V), true, true});
+    return;
+  }
+  for (int first = 0; first < V; first += capacity)
+    passes_.push_back({block(first, std::min(capacity, V - first)), true, false});
+  const int half = capacity / 2;
+  std::vector<std::vector<int>> eta, w0;
+  for (int first = 0; first < n_; first += half) {
+    eta.push_back(block(first, std::min(half, n_ - first)));
+    w0.push_back(block(n_ + first, std::min(half, n_ - first)));
+  }
+  const auto joined = [](std::vector<int> a, const std::vector<int>& b) {
+    a.insert(a.end(), b.begin(), b.end());
+    return a;
+  };
+  for (const auto& a : eta)
+    for (const auto& b : w0) passes_.push_back({joined(a, b), false, true});
+  for (std::size_t b = 0; b < w0.size(); ++b)
+    for (std::size_t c = b + 1; c < w0.size(); ++c) passes_.push_back({joined(w0[b], w0[c]), false, true});
+}
+
+// Every number of the state carries the pass's variables, with zero derivatives where it does not
+// depend on them: a one-step method reads the variables of its derivatives off the state's jets
+// (one_step.hpp), and on R^n those in eta enter through the field's origin, not the state.
+Jet2 ShootingDiscreteLagrangian::seeded(double value, int variable) const {
+  const int slot = variable < 0 ? -1 : slot_[variable];
+  Jet2 jet(value);
+  jet.resize(jet_size_);
+  jet.gradient.setZero();
+  jet.hessian.setZero();
+  if (slot >= 0) jet.gradient[slot] = 1.0;
+  return jet;
 }
 
 const Jet2* ShootingDiscreteLagrangian::position() {
@@ -174,8 +226,9 @@ void ShootingDiscreteLagrangian::add_work(double weight) {
   const Jet2* point = position();
   for (int r = 0; r < n_; ++r) {
     const Jet2& q = point[r];
+    if (q.constant()) continue;
     const double f = weight * force_[r].value;
-    alpha_ += f * q.gradient;
+    work_gradient_ += f * q.gradient;
     work_jacobian_ += f * q.hessian;
     if (!force_[r].constant()) work_jacobian_.noalias() += weight * q.gradient * force_[r].gradient.transpose();
   }
@@ -190,8 +243,8 @@ void ShootingDiscreteLagrangian::add_work(double weight) {
 void ShootingDiscreteLagrangian::start_point(const double* q0) {
   if (manifold_.is_vector_space()) {
     for (int r = 0; r < n_; ++r) {
-      origin_[r] = Jet2::variable(q0[r], 2 * n_, r);
-      state_[r] = Jet2(0.0);
+      origin_[r] = seeded(q0[r], r);
+      state_[r] = seeded(0.0, -1);
     }
     return;
   }
@@ -210,15 +263,34 @@ void ShootingDiscreteLagrangian::start_point(const double* q0) {
   }
 }
 
-// Propagates (q^0, w^0) = (q0 exp(eta), w0) as jets in x = (eta, w0) through the nodes, then forms
-// the generating function G and the boundary quantity B of the form.
+// The shot from (q0, w0): the propagation's values, the first derivatives of G, W and B with
+// lambda and D1 from them (first_derivatives), and, where the solve needs them, Phi's second
+// derivatives (second_derivatives), over the passes (plan_passes; every pass has the same values).
 void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, double h) {
+  bool first = false;  // lambda and D1 known
+  for (const Pass& pass : passes_) {
+    if (!pass.first_order && !second_order_) continue;
+    propagate(q0, w0, h, pass);
+    if (pass.first_order) gather(pass);
+    if (!pass.second_order || !second_order_) continue;
+    if (!first) first_derivatives();
+    first = true;
+    second_derivatives(pass);
+  }
+  if (!first) first_derivatives();
+}
+
+// Propagates (q^0, w^0) = (q0 exp(eta), w0) as jets in the pass's numbers of x = (eta, w0) through
+// the nodes, then forms the generating function G and the boundary quantity B of the form.
+void ShootingDiscreteLagrangian::propagate(const double* q0, const double* w0, double h, const Pass& pass) {
+  std::fill(slot_.begin(), slot_.end(), -1);
+  for (std::size_t j = 0; j < pass.variables.size(); ++j) slot_[pass.variables[j]] = static_cast<int>(j);
   start_point(q0);
-  for (int r = 0; r < n_; ++r) state_[m_ + r] = Jet2::variable(w0[r], 2 * n_, n_ + r);
+  for (int r = 0; r < n_; ++r) state_[m_ + r] = seeded(w0[r], n_ + r);
   if (mechanical_ != nullptr && mechanical_->clock()) state_[2 * n_] = Jet2(t_);
   if (mechanical_ != nullptr) mechanical_->set_forced(forced_);
-  alpha_.setZero();
-  work_jacobian_.setZero();
+  work_gradient_.setZero(jet_size_);
+  work_jacobian_.setZero(jet_size_, jet_size_);
   Jet2 S;
   accumulate(0, h, S);
   for (std::size_t i = 1; i < nodes_.size(); ++i) {
@@ -235,7 +307,6 @@ void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, doubl
     generating_ = S;
     boundary();
   }
-  alpha_ += generating_.gradient;
 }
 
 // B = local(q1, q^n), the natural chart at the far end (paper, sec. 2 "Natural charts"): at
@@ -275,15 +346,27 @@ void ShootingDiscreteLagrangian::boundary() {
   }
 }
 
-// lambda = B_w^{-T} alpha_w, D1 = alpha_q - B_q^T lambda, Phi = d alpha/dx - sum_r lambda_r Hess B_r,
-// alpha = G_x (+ W_x with forces; Phi's rows are alpha's components, its columns the variables).
+namespace {
+
+// A jet's first and second derivatives in its variables i, j (zero for a constant).
+double first(const Jet2& x, int i) { return x.constant() ? 0.0 : x.gradient[i]; }
+double second(const Jet2& x, int i, int j) { return x.constant() ? 0.0 : x.hessian(i, j); }
+
+}  // namespace
+
+// The pass's first derivatives: alpha = G_x + W_x and B_x (B_x = [Bq_, Bw_]) in its numbers of x.
+void ShootingDiscreteLagrangian::gather(const Pass& pass) {
+  for (std::size_t j = 0; j < pass.variables.size(); ++j) {
+    const int x = pass.variables[j], i = static_cast<int>(j);
+    alpha_[x] = first(generating_, i) + work_gradient_[i];
+    for (int r = 0; r < n_; ++r) (x < n_ ? Bq_(r, x) : Bw_(r, x - n_)) = first(boundary_[r], i);
+  }
+}
+
+// lambda = B_w^{-T} alpha_w, D1 = alpha_q - B_q^T lambda.
 // With offsets (on a vector space, Type I forms) B_q = I + Bq_, and the momentum change of the
 // step is D1 + D2 = alpha_q - Bq_^T lambda: small terms, each to its own relative precision.
-void ShootingDiscreteLagrangian::differentiate() {
-  for (int r = 0; r < n_; ++r) {
-    Bq_.row(r) = boundary_[r].gradient.head(n_).transpose();
-    Bw_.row(r) = boundary_[r].gradient.tail(n_).transpose();
-  }
+void ShootingDiscreteLagrangian::first_derivatives() {
   BwT_lu_.compute(Bw_.transpose());
   lambda_.noalias() = BwT_lu_.solve(alpha_.tail(n_));
   D1_ = alpha_.head(n_);
@@ -292,9 +375,18 @@ void ShootingDiscreteLagrangian::differentiate() {
     momentum_change_ = D1_;
     D1_ -= lambda_;
   }
-  phi_ = generating_.hessian;
-  if (forced_) phi_ += work_jacobian_;
-  for (int r = 0; r < n_; ++r) phi_ -= lambda_[r] * boundary_[r].hessian;
+}
+
+// Phi = d alpha/dx - sum_r lambda_r Hess B_r in pairs of the pass's numbers of x (alpha = G_x, + W_x
+// with forces; Phi's rows are alpha's components, its columns the variables).
+void ShootingDiscreteLagrangian::second_derivatives(const Pass& pass) {
+  const int k = static_cast<int>(pass.variables.size());
+  for (int j = 0; j < k; ++j)
+    for (int i = 0; i < k; ++i) {
+      double phi = second(generating_, i, j) + work_jacobian_(i, j);
+      for (int r = 0; r < n_; ++r) phi -= lambda_[r] * second(boundary_[r], i, j);
+      phi_(pass.variables[i], pass.variables[j]) = phi;
+    }
 }
 
 // residual_ and its Jacobian in w0, jacobian_, for the target:
@@ -338,7 +430,6 @@ struct ShootingDiscreteLagrangian::Equations {
   // F's round-off yardstick: the largest of its terms, the given data and D1 (momentum) or B.
   double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
     s.shoot(q0, s.w_.data(), h);
-    s.differentiate();
     s.residual(target, data);
     F = s.residual_;
     double yardstick = Eigen::Map<const Eigen::VectorXd>(data, s.n_).lpNorm<Eigen::Infinity>();
@@ -355,12 +446,14 @@ struct ShootingDiscreteLagrangian::Equations {
   // The step's outcome at the updated w0, to first order from the last shot (no propagation):
   // the state's values by their w0-derivatives, lambda by dlambda/dw0 = B_w^{-T} Phi_ww, the
   // momentum change by dD1/dw0 + dlambda/dw0, the residual by its Jacobian.
+  // On a Lie group the point is the state's (one pass, whose variables are x = (eta, w0)); on a
+  // vector space it is read from B.
   void finish(const Eigen::VectorXd& update) {
     if (target != Target::momentum) return;
-    for (int r = 0; r < s.m_; ++r)
-      if (!s.state_[r].constant()) s.state_[r].value -= s.state_[r].gradient.tail(s.n_).dot(update);
-    for (int r = 0; r < s.n_; ++r)
-      if (!s.boundary_[r].constant()) s.boundary_[r].value -= s.boundary_[r].gradient.tail(s.n_).dot(update);
+    if (!s.manifold_.is_vector_space())
+      for (int r = 0; r < s.m_; ++r)
+        if (!s.state_[r].constant()) s.state_[r].value -= s.state_[r].gradient.tail(s.n_).dot(update);
+    for (int r = 0; r < s.n_; ++r) s.boundary_[r].value -= s.Bw_.row(r).dot(update);
     s.lambda_.noalias() -= s.lambda_jacobian_ * update;
     if (s.offsets()) {
       s.momentum_change_.noalias() -= s.jacobian_ * update;
@@ -375,6 +468,7 @@ struct ShootingDiscreteLagrangian::Equations {
 void ShootingDiscreteLagrangian::solve(const double* q0, double h, Target target,
                                        const double* data) {
   Equations equations{*this, q0, h, target, data};
+  second_order_ = target != Target::boundary;
   require_converged(solver_.solve(equations, statistics_), "the shooting equations");
 }
 
@@ -403,7 +497,7 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
       carry_q_.setZero();
       carry_p_.setZero();
     }
-    for (int r = 0; r < n_; ++r) offset_[r] = state_[r].value;
+    for (int r = 0; r < n_; ++r) offset_[r] = boundary_[r].value;
     momentum_change_ -= residual_;
     end_q_ = start;
     compensated_add(end_q_, offset_, carry_q_);

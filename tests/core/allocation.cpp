@@ -145,3 +145,25 @@ TEST_CASE("shooting steps with a configuration-dependent mass matrix allocate no
       CHECK(count == 0);
     }
 }
+
+TEST_CASE("shooting steps in passes (R^8, jets of 16 variables over the 12 a jet holds: the sensitivities in 2 + 5 "
+          "passes) allocate nothing, explicit and implicit") {
+  Pendulums pendulums(8);  // declares its constant mass matrix
+  FlatSpace space(8);
+  auto rule = lobatto3();
+  for (bool implicit : {false, true}) {
+    CAPTURE(implicit);
+    sdk::RungeKutta method = implicit ? gauss2() : rk4();
+    ShootingDiscreteLagrangian map(space, pendulums, rule, method, ShootingForm::lagrangian, {});
+    Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(8, 1.3, 0.2), p = Eigen::VectorXd::Zero(8), q1(8), p1(8);
+    map.step(q.data(), p.data(), 0.1, q1.data(), p1.data());
+    const long count = allocations_of([&] {
+      for (int k = 0; k < 10; ++k) {
+        map.step(q1.data(), p1.data(), 0.1, q.data(), p.data());
+        q.swap(q1);
+        p.swap(p1);
+      }
+    });
+    CHECK(count == 0);
+  }
+}

@@ -35,6 +35,17 @@ struct PlanarKepler : sdk::AutodiffLagrangian<PlanarKepler> {
   }
 };
 
+// The double pendulum (unit masses and lengths): L = v1^2 + 1/2 v2^2 + v1 v2 cos(q1 - q2) + 2 cos q1
+// + cos q2, a configuration-dependent mass matrix, declared as none.
+struct DoublePendulum : sdk::AutodiffLagrangian<DoublePendulum> {
+  DoublePendulum() : sdk::AutodiffLagrangian<DoublePendulum>(2, 2) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::cos;
+    return v(0) * v(0) + 0.5 * v(1) * v(1) + v(0) * v(1) * cos(q(0) - q(1)) + 2.0 * cos(q(0)) + cos(q(1));
+  }
+};
+
 inline sdk::RungeKutta rk4() { return {sdk::classic_rk4(), 4, false}; }
 inline sdk::RungeKutta explicit_midpoint() { return {sdk::explicit_midpoint(), 2, false}; }
 inline sdk::RungeKutta implicit_midpoint() { return {sdk::collocation_tableau({0.5}), 2, true}; }

@@ -81,21 +81,6 @@ TEST_CASE("an implicit method at jets carries the exact derivatives of its step"
   }
 }
 
-namespace {
-
-// The double pendulum (unit masses and lengths): L = v1^2 + 1/2 v2^2 + v1 v2 cos(q1 - q2) + 2 cos q1
-// + cos q2, a configuration-dependent mass matrix, declared as none.
-struct DoublePendulum : sdk::AutodiffLagrangian<DoublePendulum> {
-  DoublePendulum() : sdk::AutodiffLagrangian<DoublePendulum>(2, 2) {}
-  template <class T>
-  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
-    using std::cos;
-    return v(0) * v(0) + 0.5 * v(1) * v(1) + v(0) * v(1) * cos(q(0) - q(1)) + 2.0 * cos(q(0)) + cos(q(1));
-  }
-};
-
-}  // namespace
-
 TEST_CASE("the tangent field (q, v) of a configuration-dependent mass matrix: its Jacobian and its jets' second "
           "derivatives pass Taylor tests against the field's own values (issue #18: the lagrangian form of "
           "shooting for the double pendulum)") {

@@ -9,10 +9,12 @@
 #include <sstream>
 
 #include "../core/fixtures.hpp"
+#include "../core/shooting_fixtures.hpp"
 #include "../sdk/morse_chain.hpp"
 #include "load_plugin.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/mechanics.hpp"
+#include "varia/core/shooting.hpp"
 #include "varia/sdk/conformance/lagrangian.hpp"
 
 namespace {
@@ -113,4 +115,48 @@ TEST_CASE("Galerkin on the 60-DOF morse chain: the term-wise plugin and the dens
   REQUIRE(r.size() >= 2);
   for (std::size_t k = 1; k < r.size(); ++k)
     if (r[k] > 1e-13) CHECK(r[k] <= 10 * r[k - 1] * r[k - 1]);
+}
+
+TEST_CASE("shooting on the 60-DOF morse chain (rk4 + Simpson, lagrangian form, the sensitivities in passes of "
+          "12 jet variables): Newton converges quadratically, and the linear and angular momenta of the plane's "
+          "rigid motions, which every Runge-Kutta method commutes with, are conserved to round-off (issue #18)") {
+  MorseChainParameters p;
+  const auto chain = plugin_chain(p);
+  const int n = 2 * p.particles;
+  varia::testing::FlatSpace space(n);
+  auto rule = varia::testing::simpson();
+  auto method = varia::testing::rk4();
+  varia::ShootingDiscreteLagrangian map(space, *chain, rule, method, varia::ShootingForm::lagrangian, {});
+  VectorXd q, v;
+  varia::testing::morse_chain_state(p, 3, q, v);
+  VectorXd momentum = p.mass * v, q1(n), p1(n);
+  // The momenta of translations along x and y and of rotations about the origin.
+  const auto momenta = [&](const VectorXd& x, const VectorXd& m) {
+    Eigen::Vector3d J = Eigen::Vector3d::Zero();
+    for (int i = 0; i < n; i += 2) J += Eigen::Vector3d(m[i], m[i + 1], x[i] * m[i + 1] - x[i + 1] * m[i]);
+    return J;
+  };
+  const Eigen::Vector3d J0 = momenta(q, momentum);
+  const double h = 0.2;  // long enough steps for three Newton iterations
+  const auto start = std::chrono::steady_clock::now();
+  const int steps = 3;
+  for (int k = 0; k < steps; ++k) {
+    map.step(q.data(), momentum.data(), h, q1.data(), p1.data());
+    q.swap(q1);
+    momentum.swap(p1);
+    const auto& r = map.last_residuals();
+    std::ostringstream residuals;
+    for (double x : r) residuals << " " << x;
+    MESSAGE("step " << k << ": Newton residuals" << residuals.str());
+    REQUIRE(r.size() >= 3);
+    for (std::size_t i = 1; i < r.size(); ++i)
+      if (r[i] > 1e-13) CHECK(r[i] <= 10 * r[i - 1] * r[i - 1]);
+  }
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  MESSAGE("60 DOF, rk4 + Simpson, h = " << h << ": Newton iterations per step " << map.solver_statistics().mean()
+                                        << "; time per step " << seconds / steps << " s");
+  const Eigen::Vector3d J = momenta(q, momentum);
+  CAPTURE(J0.transpose());
+  CAPTURE(J.transpose());
+  CHECK((J - J0).lpNorm<Eigen::Infinity>() <= 1e-14 * (1.0 + J0.lpNorm<Eigen::Infinity>()));
 }

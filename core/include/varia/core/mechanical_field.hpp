@@ -52,6 +52,10 @@ class EulerLagrangeField : public VectorField {
   // (constant_mass()); the derived fields that need one refuse the others.
   explicit EulerLagrangeField(LagrangianEvaluator& lagrangian);
   bool constant_mass() const { return constant_mass_; }
+  // The most variables the field's jets may hold (eval at jets): Jet2's capacity, or fewer where
+  // the Lagrangian's derivatives at jets take fewer. The shooting construction propagates its
+  // sensitivities in passes of at most this many directions (shooting.hpp).
+  virtual int jet_variables() const { return kMaxJetVariables; }
 
   // y1 = Psi_h(y0) by `method`, its stage iterations recorded in `stages`. Throws
   // NumericalFailure (stage equations that do not converge, a non-finite state) or PluginFault.
@@ -97,10 +101,12 @@ class EulerLagrangeField : public VectorField {
 class MechanicalField final : public EulerLagrangeField {
  public:
   // The tangent form throws std::invalid_argument unless the Lagrangian declares a constant mass
-  // matrix or gives its Hessian at jets of 2n variables. The forces (may be null or empty: none)
-  // are applied while forced() is on.
+  // matrix or gives its Hessian at jets of at least 2 variables. The forces (may be null or empty:
+  // none) are applied while forced() is on.
   MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace space, Forces* forces = nullptr);
   int size() const noexcept override { return 2 * n_ + (clock() ? 1 : 0); }
+  // The tangent form with a configuration-dependent mass matrix: L's Hessian at jets bounds them.
+  int jet_variables() const override;
   Status eval(const double* y, double* f) noexcept override;
   Status eval(const Jet2* y, Jet2* f) noexcept override;
   Status jacobian(const double* y, double* f, double* df) noexcept override;
@@ -167,6 +173,7 @@ class MechanicalField final : public EulerLagrangeField {
   Eigen::PartialPivLU<Eigen::MatrixXd> mass_lu_;  // L_vv at the last state (not constant_mass())
   std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;  // the last also acceleration()'s right side, residual
   std::vector<Jet2> hessian_jet_, seed_, acceleration_jet_, correction_jet_;  // correction_jet_: M^{-1} times a residual
+  int hessian_jet_variables_;  // the Lagrangian's (Lagrangian::hessian_jet_variables)
   SolverOptions legendre_options_;
 };
 

@@ -66,7 +66,10 @@ class OneStepMethod : public PluginObject {
   // Tolerance and iteration limit of the stage equations of implicit methods.
   virtual void set_solver(double tolerance, int max_iterations) noexcept = 0;
   // y1 = Psi_h(y0) for y in R^N, N = field.size(). At jets, y1 carries the exact derivatives of
-  // Psi_h(y0) with respect to the variables of y0.
+  // Psi_h(y0) with respect to the variables of y0. Every number of y0 carries all of them (with
+  // zero derivatives where it does not depend on one), and the field's jets may depend on them
+  // through the field itself (the shooting construction's origin on R^n), so a method reads the
+  // number of variables off any number of y0.
   virtual Status step(VectorField& field, double h, const double* y0, double* y1,
                       StageSolve* report) noexcept = 0;
   virtual Status step(VectorField& field, double h, const Jet2* y0, Jet2* y1,

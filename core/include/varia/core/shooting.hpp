@@ -53,10 +53,16 @@
 // momenta are body momenta, as lie-verlet's. The lagrangian form only, no forces, no end-derivative
 // quadratures there.
 //
-// Restrictions: a manifold of dimension n <= 6 (jets of 2n <= kMaxJetVariables = 12 variables:
-// SE(3)); the lagrangian form with a configuration-dependent mass matrix needs L's Hessian at jets
-// of 2n variables (the SDK gives it on R^1..R^3), the hamiltonian and type-2 forms take any
-// regular Lagrangian (mechanical_field.hpp).
+// Sensitivities in passes: a jet holds at most kMaxJetVariables = 12 variables, or fewer where the
+// field's derivatives at jets take fewer (MechanicalField::jet_variables). Where 2n exceeds that,
+// the state is propagated in passes over a few numbers of x each (plan_passes): first derivatives
+// over blocks of x, and of the second derivatives only Phi's columns in w0, the Newton Jacobian's,
+// over pairs of blocks. Every pass has the same values; together they give the one-pass derivatives.
+//
+// Restrictions: a Lie group of dimension n <= 6 (one pass of jets of 2n <= 12 variables: SE(3));
+// R^n of any dimension. The lagrangian form with a configuration-dependent mass matrix needs L's
+// Hessian at jets of at least 2 variables (the SDK gives 6); the hamiltonian and type-2 forms take
+// any regular Lagrangian (mechanical_field.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -116,12 +122,27 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
     boundary,   // B - q1: evaluate in a Type I form
     lambda,     // lambda - q1: evaluate in the type_2 form
   };
+  // One propagation of the state as jets: which of x = (eta, w0)'s 2n numbers are its jet
+  // variables (at most the field's jet_variables()), and what it gives: first derivatives (of G,
+  // W and B, in its variables) and second derivatives (in pairs of its variables). See shoot().
+  struct Pass {
+    std::vector<int> variables;
+    bool first_order, second_order;
+  };
+  void plan_passes(int capacity);
+  // The jet of x's number `variable` (-1: none) at `value` in the current pass: one of its
+  // variables, or a jet of zero derivatives in them. Every pass's jets have jet_size_ variables,
+  // its unused ones with zero derivatives: a one-step method's workspace then keeps its size.
+  Jet2 seeded(double value, int variable) const;
   void start_point(const double* q0);
   void boundary();
   void shoot(const double* q0, const double* w0, double h);
+  void propagate(const double* q0, const double* w0, double h, const Pass& pass);
   void accumulate(int node, double h, Jet2& S);
   void add_work(double weight);
-  void differentiate();
+  void gather(const Pass& pass);
+  void first_derivatives();
+  void second_derivatives(const Pass& pass);
   void residual(Target target, const double* data);
   struct Equations;  // the shooting equations as a NewtonSolver system
   void solve(const double* q0, double h, Target target, const double* data);
@@ -146,7 +167,11 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   double t_ = 0.0;       // the time at the start of the step being taken
   bool forced_ = false;  // forces applied in the current solve (steps of a forced system)
   bool target_is_end_ = false;  // B's chart at q^n's value (a step) or at target_ (evaluate)
-  std::vector<double> target_, zero_ = std::vector<double>(kMaxJetVariables, 0.0);
+  std::vector<double> target_, zero_;
+  std::vector<Pass> passes_;
+  std::vector<int> slot_;        // the current pass's jet variable of each number of x, or -1
+  int jet_size_ = 0;             // the jets' number of variables in every pass (a pass may use fewer)
+  bool second_order_ = true;     // whether the current solve needs Phi (its Jacobian does)
   SolverStatistics statistics_, stages_;
   mutable EvaluationCounters counters_;
   // Workspace, sized once: a step allocates nothing.
@@ -158,7 +183,8 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
       local_hessian_;
   Eigen::VectorXd w_, v_values_, lambda_, D1_, residual_;
   Eigen::VectorXd alpha_;        // G_x + W_x: the forced 1-form in x = (q0, w0)
-  Eigen::MatrixXd work_jacobian_;  // dW_x/dx
+  Jet2::Gradient work_gradient_;  // W_x and dW_x/dx in the current pass's variables
+  Jet2::Hessian work_jacobian_;
   Eigen::MatrixXd Bq_, Bw_, phi_, jacobian_;
   Eigen::MatrixXd lambda_jacobian_;  // dlambda/dw0 = B_w^{-T} Phi_ww
   // Compensated sums q1 = q0 + (q^n - q0), p1 = p0 + (p1 - p0) across steps (compensated.hpp):

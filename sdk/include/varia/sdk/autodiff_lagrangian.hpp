@@ -17,7 +17,8 @@
 // time), gives gradient_jet, for up to kStackVariables numbers (the shooting construction's jets
 // hold fewer variables than that). Forward mode over forward mode at jet values (jet_tangent.hpp)
 // gives hessian_jet at jets of up to 6 variables, which the shooting construction's lagrangian
-// form needs for a configuration-dependent mass matrix on R^1..R^3.
+// form needs for a configuration-dependent mass matrix (it propagates in passes of at most that
+// many variables: any dimension up to kStackVariables / 2).
 #pragma once
 
 #include <Eigen/Core>
@@ -99,7 +100,7 @@ class AutodiffLagrangian : public Lagrangian {
       if (variables <= 4) return hessian_at_fixed_jets<4>(q, v, variables, hessian);
       if (variables <= kMaxHessianJetVariables) return hessian_at_fixed_jets<6>(q, v, variables, hessian);
       throw std::length_error("an autodiff Lagrangian gives its Hessian at jets of at most " +
-                              std::to_string(kMaxHessianJetVariables) + " variables (a shooting step on R^1..R^3)");
+                              std::to_string(kMaxHessianJetVariables) + " variables (hessian_jet_variables())");
     });
   }
 
@@ -182,7 +183,7 @@ class AutodiffLagrangian : public Lagrangian {
   }
   // gradient_jet at jets of N variables: the model at dual numbers over FixedJet<N> (N + N^2
   // numbers each, every loop of the chain rule of a fixed length), converted from and to Jet2.
-  // A shooting step's jets have twice the manifold's dimension in variables (R^1..R^3).
+  // A shooting pass's jets have up to twice the manifold's dimension in variables (shooting.hpp).
   template <int N>
   void at_fixed_jets(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) const {
     std::array<FixedJet<N>, kStackVariables> inputs, outputs;
