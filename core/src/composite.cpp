@@ -93,6 +93,39 @@ Status CompositeLagrangian::evaluate(const double* q, const double* v, double* v
   }
 }
 
+bool CompositeLagrangian::evaluates_at_jets() const noexcept {
+  return std::all_of(terms_.begin(), terms_.end(), [](const Term& term) { return term.effect->evaluates_at_jets(); });
+}
+
+// The same sums at jets: dL/dq = -sum_e dV_e/dq at jets, dL/dv_j = m_j v_j.
+Status CompositeLagrangian::gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept {
+  try {
+    if (value != nullptr) {
+      *value = Jet2(0.0);
+      for (int j = 0; j < n_; ++j) *value += (0.5 * masses_[j]) * (v[j] * v[j]);
+    }
+    for (int j = 0; j < n_; ++j) {
+      gradient[j] = Jet2(0.0);
+      gradient[n_ + j] = masses_[j] * v[j];
+    }
+    for (Term& term : terms_) {
+      const std::size_t k = term.x.size();
+      term.x_jets.resize(k);
+      term.gradient_jets.resize(k);
+      for (std::size_t j = 0; j < k; ++j) term.x_jets[j] = q[term.indices[j]];
+      Jet2 V;
+      if (Status status = term.effect->gradient_jet(term.x_jets.data(), value ? &V : nullptr, term.gradient_jets.data()))
+        throw std::runtime_error(std::string("effect: ") + status);
+      if (value != nullptr) *value -= V;
+      for (std::size_t j = 0; j < k; ++j) gradient[term.indices[j]] -= term.gradient_jets[j];
+    }
+    return nullptr;
+  } catch (const std::exception& e) {
+    error_ = e.what();
+    return error_.c_str();
+  }
+}
+
 int CompositeLagrangian::hessian_pattern(const int** rows, const int** cols) const noexcept {
   return pattern_.entries(rows, cols);
 }

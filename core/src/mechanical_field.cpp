@@ -324,11 +324,6 @@ void MechanicalField::general_tangent_jacobian(const double* y, double* f, doubl
   if (clock()) f[2 * n_] = 1.0;
 }
 
-namespace {
-double value_of(double x) { return x; }
-double value_of(const Jet2& x) { return x.value; }
-}  // namespace
-
 template <class T>
 void EulerLagrangeField::advance(OneStepMethod& method, double h, const T* y0, T* y1,
                               SolverStatistics& stages) {

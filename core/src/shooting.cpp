@@ -23,7 +23,8 @@ Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingFo
   if (!lagrangian.evaluates_at_jets())
     throw std::invalid_argument("the shooting construction propagates jets through the Euler-Lagrange field, and "
                                 "this Lagrangian does not evaluate at jets (models derived from "
-                                "sdk::AutodiffLagrangian do; the composite Lagrangian does not)");
+                                "sdk::AutodiffLagrangian or sdk::TermwiseLagrangian do, and a composite Lagrangian "
+                                "whose effects all do: Effect::gradient_jet)");
   if (!manifold.is_vector_space() && 2 * manifold.dim() > kMaxJetVariables)
     throw std::invalid_argument("the shooting construction on a Lie group differentiates the propagation with "
                                 "jets of at most " + std::to_string(kMaxJetVariables) +

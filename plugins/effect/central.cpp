@@ -41,17 +41,32 @@ class Central final : public varia::sdk::ParticleEffect {
     dense_pattern();
   }
 
+  bool evaluates_at_jets() const noexcept override { return true; }
   void potential(const double* x, double* value, double* gradient, double* hessian) const override {
+    first_order(x, value, gradient);
+    if (hessian == nullptr) return;
     const Eigen::VectorXd d =
         Eigen::Map<const Eigen::VectorXd>(x, d_) - Eigen::Map<const Eigen::VectorXd>(center_.data(), d_);
     const double r = d.norm();
-    if (r == 0.0) throw std::domain_error("a particle is at the center of a central attraction");
+    Eigen::Map<Eigen::MatrixXd>(hessian, d_, d_) =
+        mu_ * masses_[particle_] / (r * r * r) * (Eigen::MatrixXd::Identity(d_, d_) - 3.0 / (r * r) * d * d.transpose());
+  }
+  void potential_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) const override {
+    first_order(x, value, gradient);
+  }
+  // V = -k/r and dV/dx = k d / r^3 (d = x - center, r = |d|) at doubles or jets.
+  template <class T>
+  void first_order(const T* x, T* value, T* gradient) const {
+    using std::sqrt;
+    T s(0.0);
+    for (int a = 0; a < d_; ++a) s += (x[a] - center_[a]) * (x[a] - center_[a]);
+    if (varia::value_of(s) == 0.0) throw std::domain_error("a particle is at the center of a central attraction");
     const double k = mu_ * masses_[particle_];
+    const T r = sqrt(s);
     if (value != nullptr) *value = -k / r;
-    if (gradient != nullptr) Eigen::Map<Eigen::VectorXd>(gradient, d_) = k / (r * r * r) * d;
-    if (hessian != nullptr)
-      Eigen::Map<Eigen::MatrixXd>(hessian, d_, d_) =
-          k / (r * r * r) * (Eigen::MatrixXd::Identity(d_, d_) - 3.0 / (r * r) * d * d.transpose());
+    if (gradient == nullptr) return;
+    const T c = k / (r * r * r);
+    for (int a = 0; a < d_; ++a) gradient[a] = c * (x[a] - center_[a]);
   }
 
   double mu_;

@@ -51,18 +51,48 @@ class Gravitation final : public varia::sdk::ParticleEffect {
     difference_.resize(d_);
   }
 
+  bool evaluates_at_jets() const noexcept override { return true; }
   void potential(const double* x, double* value, double* gradient, double* hessian) const override {
+    first_order(x, value, gradient);
+    if (hessian == nullptr) return;
     const int n = particles_ * d_;
-    if (value != nullptr) *value = 0.0;
-    if (gradient != nullptr) std::fill(gradient, gradient + n, 0.0);
-    if (hessian != nullptr) std::fill(hessian, hessian + static_cast<std::size_t>(n) * n, 0.0);
+    std::fill(hessian, hessian + static_cast<std::size_t>(n) * n, 0.0);
     for (int i = 0; i < particles_; ++i)
-      for (int j = i + 1; j < particles_; ++j) add_pair(i, j, x, value, gradient, hessian);
+      for (int j = i + 1; j < particles_; ++j) add_pair_hessian(i, j, x, hessian);
+  }
+  void potential_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) const override {
+    first_order(x, value, gradient);
   }
 
-  // The pair (i, j)'s term of V and its derivatives, added in place (the Hessian column-major,
-  // n x n over all coordinates: dense_pattern's order).
-  void add_pair(int i, int j, const double* x, double* value, double* gradient, double* hessian) const {
+  // V = -sum_{i<j} k_ij / r_ij and dV/dx (k_ij = G m_i m_j, r_ij^2 = |x_i - x_j|^2 + softening^2),
+  // at doubles or jets.
+  template <class T>
+  void first_order(const T* x, T* value, T* gradient) const {
+    using std::sqrt;
+    if (value != nullptr) *value = T(0.0);
+    if (gradient != nullptr) std::fill(gradient, gradient + particles_ * d_, T(0.0));
+    for (int i = 0; i < particles_; ++i)
+      for (int j = i + 1; j < particles_; ++j) {
+        const auto difference = [&](int a) -> T { return x[i * d_ + a] - x[j * d_ + a]; };
+        T s(softening_ * softening_);
+        for (int a = 0; a < d_; ++a) s += difference(a) * difference(a);
+        if (varia::value_of(s) == 0.0) throw std::domain_error("two particles are at one point of an unsoftened gravitation");
+        const double k = G_ * masses_[i] * masses_[j];
+        const T r = sqrt(s);
+        if (value != nullptr) *value -= k / r;
+        if (gradient == nullptr) continue;
+        const T k_r3 = k / (s * r);
+        for (int a = 0; a < d_; ++a) {
+          const T g = k_r3 * difference(a);
+          gradient[i * d_ + a] += g;
+          gradient[j * d_ + a] -= g;
+        }
+      }
+  }
+
+  // The pair (i, j)'s block of the Hessian, added in place (column-major, n x n over all
+  // coordinates: dense_pattern's order).
+  void add_pair_hessian(int i, int j, const double* x, double* hessian) const {
     const int n = particles_ * d_;
     double* dd = difference_.data();
     double s = softening_ * softening_;
@@ -70,15 +100,7 @@ class Gravitation final : public varia::sdk::ParticleEffect {
       dd[a] = x[i * d_ + a] - x[j * d_ + a];
       s += dd[a] * dd[a];
     }
-    if (s == 0.0) throw std::domain_error("two particles are at one point of an unsoftened gravitation");
     const double k = G_ * masses_[i] * masses_[j], r = std::sqrt(s), k_r3 = k / (s * r);
-    if (value != nullptr) *value -= k / r;
-    if (gradient != nullptr)
-      for (int a = 0; a < d_; ++a) {
-        gradient[i * d_ + a] += k_r3 * dd[a];
-        gradient[j * d_ + a] -= k_r3 * dd[a];
-      }
-    if (hessian == nullptr) return;
     for (int b = 0; b < d_; ++b)
       for (int a = 0; a < d_; ++a) {
         const double B = k_r3 * ((a == b ? 1.0 : 0.0) - 3.0 * dd[a] * dd[b] / s);

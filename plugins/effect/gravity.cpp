@@ -32,13 +32,22 @@ class Gravity final : public varia::sdk::ParticleEffect {
     for (int i = 0; i < particles_; ++i) use_particle(i, "g");
   }
 
+  bool evaluates_at_jets() const noexcept override { return true; }
   void potential(const double* x, double* value, double* gradient, double*) const override {
-    if (value != nullptr) *value = 0.0;
+    first_order(x, value, gradient);
+  }
+  void potential_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) const override {
+    first_order(x, value, gradient);
+  }
+  // V and dV/dx at doubles or jets.
+  template <class T>
+  void first_order(const T* x, T* value, T* gradient) const {
+    if (value != nullptr) *value = T(0.0);
     for (int i = 0; i < particles_; ++i)
       for (int k = 0; k < d_; ++k) {
         const int j = i * d_ + k;
         if (value != nullptr) *value -= masses_[i] * g_[k] * x[j];
-        if (gradient != nullptr) gradient[j] = -masses_[i] * g_[k];
+        if (gradient != nullptr) gradient[j] = T(-masses_[i] * g_[k]);
       }
   }
 

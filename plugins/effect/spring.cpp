@@ -123,20 +123,53 @@ class Spring final : public varia::sdk::ParticleEffect {
     d_buffer_.resize(d_);
   }
 
+  bool evaluates_at_jets() const noexcept override { return true; }
   void potential(const double* x, double* value, double* gradient, double* hessian) const override {
-    if (value != nullptr) *value = 0.0;
-    if (gradient != nullptr) std::fill(gradient, gradient + coordinates_, 0.0);
+    first_order(x, value, gradient);
+    if (hessian == nullptr) return;
     for (const auto& spring : springs_) {
       const int ends = spring[1] == kAnchor ? 1 : 2;
-      add_spring(spring, x, value, gradient, hessian);
-      if (hessian != nullptr) hessian += (ends * d_) * (ends * d_);
+      add_spring_hessian(spring, x, hessian);
+      hessian += (ends * d_) * (ends * d_);
+    }
+  }
+  void potential_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) const override {
+    first_order(x, value, gradient);
+  }
+
+  // V and dV/dx at doubles or jets: each spring adds k/2 (|d| - r)^2 and +-k (1 - r/|d|) d at its
+  // ends (k/2 |d|^2 and +-k d for r = 0, with no square root: smooth at |d| = 0).
+  template <class T>
+  void first_order(const T* x, T* value, T* gradient) const {
+    using std::sqrt;
+    if (value != nullptr) *value = T(0.0);
+    if (gradient != nullptr) std::fill(gradient, gradient + coordinates_, T(0.0));
+    const double sign[2] = {1.0, -1.0};
+    for (const auto& spring : springs_) {
+      const int ends = spring[1] == kAnchor ? 1 : 2;
+      const auto difference = [&](int a) -> T {
+        return ends == 2 ? x[spring[0] * d_ + a] - x[spring[1] * d_ + a] : x[spring[0] * d_ + a] - anchor_[a];
+      };
+      T length2(0.0);
+      for (int a = 0; a < d_; ++a) length2 += difference(a) * difference(a);
+      T factor(k_);  // k (1 - r/|d|)
+      if (r_ > 0) {
+        if (varia::value_of(length2) == 0.0)
+          throw std::domain_error("a spring of positive rest length has both ends at one point");
+        const T length = sqrt(length2);
+        if (value != nullptr) *value += 0.5 * k_ * (length - r_) * (length - r_);
+        factor = k_ * (1.0 - r_ / length);
+      } else if (value != nullptr) {
+        *value += 0.5 * k_ * length2;
+      }
+      if (gradient == nullptr) continue;
+      for (int e = 0; e < ends; ++e)
+        for (int a = 0; a < d_; ++a) gradient[spring[e] * d_ + a] += sign[e] * factor * difference(a);
     }
   }
 
-  // One spring's V, gradient and Hessian block (its 2d x 2d or d x d values, column-major),
-  // added at its particles' slots.
-  void add_spring(const std::array<int, 2>& spring, const double* x, double* value, double* gradient,
-                  double* hessian) const {
+  // One spring's Hessian block (its 2d x 2d or d x d values, column-major).
+  void add_spring_hessian(const std::array<int, 2>& spring, const double* x, double* hessian) const {
     const int ends = spring[1] == kAnchor ? 1 : 2;
     const double* far = ends == 2 ? x + spring[1] * d_ : anchor_.data();
     double* d = d_buffer_.data();
@@ -145,15 +178,8 @@ class Spring final : public varia::sdk::ParticleEffect {
       d[a] = x[spring[0] * d_ + a] - far[a];
       length2 += d[a] * d[a];
     }
-    const double length = std::sqrt(length2);
-    if (r_ > 0 && length == 0.0) throw std::domain_error("a spring of positive rest length has both ends at one point");
-    const double ratio = r_ > 0 ? r_ / length : 0.0;  // r/|d|
-    if (value != nullptr) *value += 0.5 * k_ * (length - r_) * (length - r_);
+    const double ratio = r_ > 0 ? r_ / std::sqrt(length2) : 0.0;  // r/|d|
     const double sign[2] = {1.0, -1.0};
-    if (gradient != nullptr)
-      for (int e = 0; e < ends; ++e)
-        for (int a = 0; a < d_; ++a) gradient[spring[e] * d_ + a] += sign[e] * k_ * (1.0 - ratio) * d[a];
-    if (hessian == nullptr) return;
     const int size = ends * d_;  // block_pattern's order: column-major over (end, a)
     for (int e = 0; e < ends; ++e)
       for (int b = 0; b < d_; ++b)

@@ -68,7 +68,6 @@ const std::map<std::string, std::string> kBadScenes{
     {"momentum-without-symmetry.json", "/observe: expected no \"momentum\""},
     {"spring-between-one-particle.json", "/system/lagrangian/terms/2: parameter 'between' must name two different particles (the spring plugin effect_spring.so)"},
     {"periodic-force-amplitude-size.json", "/system/forces/1: parameter 'amplitude' must have 1 numbers"},
-    {"composite-with-shooting.json", "/method: the shooting construction propagates jets through the Euler-Lagrange field, and this Lagrangian does not evaluate at jets"},
     {"p-and-v.json", "/initial/p: not allowed here"},
     {"reduced-heavy-top.json", "/method/reduced: the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group"},
     {"reduced-se3-spring.json", "/method/reduced: the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group"},

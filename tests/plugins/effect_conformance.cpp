@@ -19,6 +19,9 @@
 #include "varia/core/composite.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/mechanics.hpp"
+#include "varia/core/shooting.hpp"
+#include "varia/sdk/conformance/effect.hpp"
+#include "../core/shooting_fixtures.hpp"
 
 namespace {
 
@@ -185,6 +188,114 @@ TEST_CASE("the composite elastic pendulum (sparse Galerkin) converges to an inde
     MESSAGE("degree " << c.degree << ": errors " << e1 << ", " << e2 << ", order " << std::log2(e1 / e2));
     CHECK(std::log2(e1 / e2) == doctest::Approx(c.order).epsilon(0.05));
   }
+}
+
+namespace {
+
+// The shooting solution (rk4 + Simpson, order 4) at T from start, step h.
+VectorXd shooting(varia::ShootingForm form, const State& start, double h, double T) {
+  varia::testing::FlatSpace space(2);
+  auto lagrangian = elastic_pendulum();
+  auto rule = varia::testing::simpson();
+  auto method = varia::testing::rk4();
+  varia::ShootingDiscreteLagrangian map(space, *lagrangian, rule, method, form, varia::SolverOptions{});
+  VectorXd q(2), p(2);
+  q << start[0], start[1];
+  p << start[2], start[3];
+  for (long k = 0; k < std::lround(T / h); ++k) map.step(q.data(), p.data(), h, q.data(), p.data());
+  VectorXd result(4);
+  result << q, p;
+  return result;
+}
+
+// The inner effect with the derivatives of its gradient at jets 1.5 times too large (the values
+// and everything at doubles right): what the effect suite's Taylor tests at jets must refuse.
+class LyingJets final : public Effect {
+ public:
+  explicit LyingJets(std::shared_ptr<Effect> inner) : inner_(std::move(inner)) {}
+  varia::Status bind(int space_dim, int particles, const double* masses) noexcept override {
+    return inner_->bind(space_dim, particles, masses);
+  }
+  int coordinates(const int** indices) const noexcept override { return inner_->coordinates(indices); }
+  int hessian_pattern(const int** rows, const int** cols) const noexcept override {
+    return inner_->hessian_pattern(rows, cols);
+  }
+  varia::Status evaluate(const double* x, double* value, double* gradient, double* hessian) noexcept override {
+    return inner_->evaluate(x, value, gradient, hessian);
+  }
+  bool evaluates_at_jets() const noexcept override { return true; }
+  varia::Status gradient_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) noexcept override {
+    const varia::Status status = inner_->gradient_jet(x, value, gradient);
+    const int* indices = nullptr;
+    for (int j = 0; status == nullptr && j < inner_->coordinates(&indices); ++j)
+      if (!gradient[j].constant()) gradient[j].gradient *= 1.5;
+    return status;
+  }
+
+ private:
+  std::shared_ptr<Effect> inner_;
+};
+
+// An effect that gives V at doubles only (Effect::gradient_jet not implemented).
+class DoublesOnly final : public Effect {
+ public:
+  varia::Status bind(int, int, const double*) noexcept override { return nullptr; }
+  int coordinates(const int** indices) const noexcept override {
+    *indices = &index_;
+    return 1;
+  }
+  int hessian_pattern(const int** rows, const int** cols) const noexcept override {
+    *rows = *cols = &entry_;
+    return 1;
+  }
+  varia::Status evaluate(const double* x, double* value, double* gradient, double* hessian) noexcept override {
+    if (value != nullptr) *value = 0.5 * x[0] * x[0];
+    if (gradient != nullptr) gradient[0] = x[0];
+    if (hessian != nullptr) hessian[0] = 1.0;
+    return nullptr;
+  }
+
+ private:
+  int index_ = 0, entry_ = 0;
+};
+
+}  // namespace
+
+TEST_CASE("the composite elastic pendulum under shooting (rk4 + Simpson, the effects' gradients at jets) converges "
+          "to the independent reference at order 4 in the lagrangian and hamiltonian forms (issue #18: composite + "
+          "shooting was refused)") {
+  const double T = 5.0;
+  const State x = reference(kStart, T);
+  const VectorXd exact = Eigen::Map<const VectorXd>(x.data(), 4);
+  for (varia::ShootingForm form : {varia::ShootingForm::lagrangian, varia::ShootingForm::hamiltonian}) {
+    const double e1 = (shooting(form, kStart, 0.04, T) - exact).norm();
+    const double e2 = (shooting(form, kStart, 0.02, T) - exact).norm();
+    MESSAGE("form " << (form == varia::ShootingForm::lagrangian ? "lagrangian" : "hamiltonian") << ": errors " << e1
+                    << ", " << e2 << ", order " << std::log2(e1 / e2));
+    CHECK(std::log2(e1 / e2) == doctest::Approx(4.0).epsilon(0.05));
+  }
+}
+
+TEST_CASE("the effect suite refuses an effect whose gradient at jets has wrong derivatives, and shooting refuses a "
+          "composite with an effect that gives no gradient at jets") {
+  LyingJets lying(make_effect("central", {{"particle", 1}}));
+  std::mt19937 engine(7);
+  const auto failures = varia::sdk::conformance::check_effect(lying, 3 * kDim, engine);
+  REQUIRE_FALSE(failures.empty());
+  CAPTURE(failures.list().front());
+  CHECK(failures.list().front().find("the gradient at jets: the first derivative") != std::string::npos);
+  auto truthful = make_effect("central", {{"particle", 1}});
+  std::mt19937 same(7);
+  CHECK(varia::sdk::conformance::check_effect(*truthful, 3 * kDim, same).empty());
+
+  varia::CompositeLagrangian composite(1, {1.0}, {std::make_shared<DoublesOnly>()});
+  CHECK_FALSE(composite.evaluates_at_jets());
+  varia::testing::FlatSpace line(1);
+  auto rule = varia::testing::simpson();
+  auto method = varia::testing::rk4();
+  CHECK_THROWS_WITH_AS(varia::ShootingDiscreteLagrangian(line, composite, rule, method, varia::ShootingForm::lagrangian,
+                                                         varia::SolverOptions{}),
+                       doctest::Contains("this Lagrangian does not evaluate at jets"), std::invalid_argument);
 }
 
 TEST_SUITE("long") {

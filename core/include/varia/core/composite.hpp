@@ -30,6 +30,10 @@ class CompositeLagrangian : public Lagrangian {
                   double* hessian) noexcept final;
   int hessian_pattern(const int** rows, const int** cols) const noexcept final;
   bool constant_mass_matrix(double* mass) const noexcept final;
+  // L and its gradient at jets, from the effects' (Effect::gradient_jet): the shooting
+  // construction's field. Available when every effect evaluates at jets.
+  bool evaluates_at_jets() const noexcept final;
+  Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final;
 
  private:
   // One effect with its gathered coordinates and where its Hessian entries go in the pattern.
@@ -38,6 +42,7 @@ class CompositeLagrangian : public Lagrangian {
     const int* indices = nullptr;
     std::vector<int> slots;
     std::vector<double> x, gradient, hessian;
+    std::vector<Jet2> x_jets, gradient_jets;  // sized at the first evaluation at jets
   };
   Term bind(std::shared_ptr<Effect> effect, std::size_t index);
   void add_term(Term& term, const double* q, double* value, double* gradient, double* hessian);

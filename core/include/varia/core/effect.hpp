@@ -5,6 +5,7 @@
 // coordinates and the Hessian of L keeps the sparsity of the effects.
 #pragma once
 
+#include "varia/core/jet.hpp"
 #include "varia/core/plugin_object.hpp"
 
 namespace varia {
@@ -24,6 +25,16 @@ class Effect : public PluginObject {
   // Hessian values, one per pattern entry. Any output may be null.
   virtual Status evaluate(const double* x, double* value, double* gradient,
                           double* hessian) noexcept = 0;
+  // V and dV/dx at jet inputs x (k jets): the jets of V(x(t)) (value may be null) and of
+  // dV/dx(x(t)) for the jet variables t. The shooting construction integrates a composite
+  // Lagrangian's Euler-Lagrange field at jets with it (its second-order jets need V's derivatives
+  // to third order). ABI 11.
+  virtual Status gradient_jet(const Jet2* /*x*/, Jet2* /*value*/, Jet2* /*gradient*/) noexcept {
+    return "this effect does not evaluate at jets";
+  }
+  // Whether gradient_jet is implemented: the composite Lagrangian evaluates at jets when all its
+  // effects do.
+  virtual bool evaluates_at_jets() const noexcept { return false; }
 };
 
 }  // namespace varia

@@ -232,6 +232,10 @@ struct FixedJet : JetArithmetic<FixedJet<N>> {
   Eigen::Matrix<double, N, N> hessian;
 };
 
+// The value of a double or a jet: code written once for both scalars tests it.
+inline double value_of(double x) { return x; }
+inline double value_of(const Jet2& x) { return x.value; }
+
 }  // namespace varia
 
 namespace Eigen {

@@ -58,12 +58,21 @@ class ParticleEffect : public Effect {
   Status evaluate(const double* x, double* value, double* gradient, double* hessian) noexcept final {
     return guarded(error_, [&] { potential(x, value, gradient, hessian); });
   }
+  Status gradient_jet(const Jet2* x, Jet2* value, Jet2* gradient) noexcept final {
+    return guarded(error_, [&] { potential_jet(x, value, gradient); });
+  }
 
  protected:
   // Chooses the coordinates (use_particle) and the Hessian pattern (dense_pattern) once bound.
   virtual void attach() = 0;
   // V, dV/dx and the Hessian values (in pattern order) at the gathered coordinates.
   virtual void potential(const double* x, double* value, double* gradient, double* hessian) const = 0;
+  // V and dV/dx at jets, for the shooting construction: an effect that gives it also returns true
+  // from evaluates_at_jets(). Write V and dV/dx once as a template on the scalar (double or Jet2)
+  // and call it from both potential() and here (the bundled effects do: plugins/effect/).
+  virtual void potential_jet(const Jet2* /*x*/, Jet2* /*value*/, Jet2* /*gradient*/) const {
+    throw std::logic_error("this effect does not evaluate at jets");
+  }
 
   // Appends particle i's d coordinates; `key` names the parameter that named it.
   void use_particle(int i, const char* key) {

@@ -5,13 +5,17 @@
 //     pattern's values summed into a k x k matrix) is symmetric;
 //   - Taylor tests along random directions d (taylor.hpp): V(x + eps d) - V(x) - eps <dV/dx, d>
 //     and dV/dx (x + eps d) - dV/dx (x) - eps H d fall as eps^2. A wrong gradient fails the first,
-//     a wrong or missing Hessian entry the second.
+//     a wrong or missing Hessian entry the second;
+//   - where the effect evaluates at jets (gradient_jet, for shooting), dV/dx at jets along a random
+//     line carries the values at doubles, and its first and second derivatives pass Taylor tests
+//     against the values at doubles and the first derivative (check_at_jets).
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include "varia/core/effect.hpp"
 #include "varia/sdk/conformance/failures.hpp"
@@ -64,6 +68,16 @@ inline void check_effect_point(Effect& effect, const Eigen::VectorXd& x, std::mt
         failures, [&](double eps) { return (at(eps).gradient - e.gradient - eps * e.hessian * d).norm(); },
         std::max(scale, h_scale), "the Hessian is not the gradient's derivative");
   }
+  if (!effect.evaluates_at_jets() || !failures.empty()) return;
+  const Eigen::VectorXd d = random_direction(k, engine);
+  check_at_jets(
+      [&](double eps) {
+        const std::vector<Jet2> line = line_jets(x, d, eps);
+        std::vector<Jet2> gradient(k);
+        check(effect, effect.gradient_jet(line.data(), nullptr, gradient.data()), "gradient_jet");
+        return gradient;
+      },
+      [&](double eps) { return effect_values(effect, x + eps * d, false).gradient; }, "the gradient", failures);
 }
 
 // The whole suite on one bound effect of a system of `size` coordinates (q), at `trials` random

@@ -14,7 +14,9 @@
 #include <cmath>
 #include <random>
 #include <string>
+#include <vector>
 
+#include "varia/core/jet.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 
 namespace varia::sdk::conformance {
@@ -59,6 +61,40 @@ void expect_taylor(Failures& failures, Remainder&& remainder, double scale, cons
     coarse = fine;
   }
   failures.expect(false, claim, ": the first-order model's error falls as eps^", slope, " (expected eps^2)");
+}
+
+// Jets along the line z + s d at s = eps, one jet variable s: value z + eps d, derivative d.
+inline std::vector<Jet2> line_jets(const Eigen::VectorXd& z, const Eigen::VectorXd& d, double eps) {
+  std::vector<Jet2> x;
+  const Jet2 s = Jet2::variable(0.0, 1, 0);
+  for (Eigen::Index i = 0; i < z.size(); ++i) x.push_back(d(i) * s + (z(i) + eps * d(i)));
+  return x;
+}
+// The values (order 0), first or second derivatives along the line of jets.
+inline Eigen::VectorXd jet_part(const std::vector<Jet2>& jets, int order) {
+  Eigen::VectorXd x(static_cast<Eigen::Index>(jets.size()));
+  for (std::size_t i = 0; i < jets.size(); ++i) {
+    const Jet2& j = jets[i];
+    x(static_cast<Eigen::Index>(i)) = order == 0 ? j.value : j.constant() ? 0.0 : order == 1 ? j.gradient(0) : j.hessian(0, 0);
+  }
+  return x;
+}
+// A quantity at jets, jets(eps) along the line z + s d, against the same at doubles, doubles(eps)
+// at z + eps d: the values agree, the first derivative passes the Taylor test against the values at
+// doubles, and the second against the first derivative at z + eps d.
+template <class Jets, class Doubles>
+void check_at_jets(Jets&& jets, Doubles&& doubles, const std::string& what, Failures& failures) {
+  const std::vector<Jet2> at = jets(0.0);
+  const Eigen::VectorXd values = doubles(0.0), first = jet_part(at, 1), second = jet_part(at, 2);
+  const double scale = std::max(1.0, values.cwiseAbs().maxCoeff());
+  const double gap = (jet_part(at, 0) - values).cwiseAbs().maxCoeff();
+  failures.expect(gap <= 1e-13 * scale, what, " at jets: its values differ from those at doubles by ", gap);
+  expect_taylor(
+      failures, [&](double eps) { return (doubles(eps) - values - eps * first).norm(); }, scale,
+      what + " at jets: the first derivative");
+  expect_taylor(
+      failures, [&](double eps) { return (jet_part(jets(eps), 1) - first - eps * second).norm(); },
+      std::max(1.0, first.cwiseAbs().maxCoeff()), what + " at jets: the second derivative");
 }
 
 }  // namespace varia::sdk::conformance
