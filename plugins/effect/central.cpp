@@ -7,7 +7,7 @@
 
 namespace {
 
-class Central final : public varia::sdk::ParticleEffect {
+class Central final : public varia::sdk::TemplatedEffect<Central> {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -41,18 +41,13 @@ class Central final : public varia::sdk::ParticleEffect {
     dense_pattern();
   }
 
-  bool evaluates_at_jets() const noexcept override { return true; }
-  void potential(const double* x, double* value, double* gradient, double* hessian) const override {
-    first_order(x, value, gradient);
-    if (hessian == nullptr) return;
+  friend varia::sdk::TemplatedEffect<Central>;
+  void second_order(const double* x, double* hessian) const {
     const Eigen::VectorXd d =
         Eigen::Map<const Eigen::VectorXd>(x, d_) - Eigen::Map<const Eigen::VectorXd>(center_.data(), d_);
     const double r = d.norm();
     Eigen::Map<Eigen::MatrixXd>(hessian, d_, d_) =
         mu_ * masses_[particle_] / (r * r * r) * (Eigen::MatrixXd::Identity(d_, d_) - 3.0 / (r * r) * d * d.transpose());
-  }
-  void potential_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) const override {
-    first_order(x, value, gradient);
   }
   // V = -k/r and dV/dx = k d / r^3 (d = x - center, r = |d|) at doubles or jets.
   template <class T>

@@ -18,7 +18,7 @@
 
 namespace {
 
-class Gravitation final : public varia::sdk::ParticleEffect {
+class Gravitation final : public varia::sdk::TemplatedEffect<Gravitation> {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -51,17 +51,12 @@ class Gravitation final : public varia::sdk::ParticleEffect {
     difference_.resize(d_);
   }
 
-  bool evaluates_at_jets() const noexcept override { return true; }
-  void potential(const double* x, double* value, double* gradient, double* hessian) const override {
-    first_order(x, value, gradient);
-    if (hessian == nullptr) return;
+  friend varia::sdk::TemplatedEffect<Gravitation>;
+  void second_order(const double* x, double* hessian) const {
     const int n = particles_ * d_;
     std::fill(hessian, hessian + static_cast<std::size_t>(n) * n, 0.0);
     for (int i = 0; i < particles_; ++i)
       for (int j = i + 1; j < particles_; ++j) add_pair_hessian(i, j, x, hessian);
-  }
-  void potential_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) const override {
-    first_order(x, value, gradient);
   }
 
   // V = -sum_{i<j} k_ij / r_ij and dV/dx (k_ij = G m_i m_j, r_ij^2 = |x_i - x_j|^2 + softening^2),

@@ -4,7 +4,7 @@
 
 namespace {
 
-class Gravity final : public varia::sdk::ParticleEffect {
+class Gravity final : public varia::sdk::TemplatedEffect<Gravity> {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -32,13 +32,8 @@ class Gravity final : public varia::sdk::ParticleEffect {
     for (int i = 0; i < particles_; ++i) use_particle(i, "g");
   }
 
-  bool evaluates_at_jets() const noexcept override { return true; }
-  void potential(const double* x, double* value, double* gradient, double*) const override {
-    first_order(x, value, gradient);
-  }
-  void potential_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) const override {
-    first_order(x, value, gradient);
-  }
+  friend varia::sdk::TemplatedEffect<Gravity>;
+  void second_order(const double*, double*) const {}  // no pattern entries
   // V and dV/dx at doubles or jets.
   template <class T>
   void first_order(const T* x, T* value, T* gradient) const {

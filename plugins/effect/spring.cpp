@@ -21,7 +21,7 @@ namespace {
 
 constexpr int kAnchor = -1;  // the far end of a spring tied to `anchor`
 
-class Spring final : public varia::sdk::ParticleEffect {
+class Spring final : public varia::sdk::TemplatedEffect<Spring> {
  public:
   static constexpr const char* version = "1.1.0";
   static constexpr const char* parameter_schema = R"json({
@@ -123,18 +123,13 @@ class Spring final : public varia::sdk::ParticleEffect {
     d_buffer_.resize(d_);
   }
 
-  bool evaluates_at_jets() const noexcept override { return true; }
-  void potential(const double* x, double* value, double* gradient, double* hessian) const override {
-    first_order(x, value, gradient);
-    if (hessian == nullptr) return;
+  friend varia::sdk::TemplatedEffect<Spring>;
+  void second_order(const double* x, double* hessian) const {
     for (const auto& spring : springs_) {
       const int ends = spring[1] == kAnchor ? 1 : 2;
       add_spring_hessian(spring, x, hessian);
       hessian += (ends * d_) * (ends * d_);
     }
-  }
-  void potential_jet(const varia::Jet2* x, varia::Jet2* value, varia::Jet2* gradient) const override {
-    first_order(x, value, gradient);
   }
 
   // V and dV/dx at doubles or jets: each spring adds k/2 (|d| - r)^2 and +-k (1 - r/|d|) d at its

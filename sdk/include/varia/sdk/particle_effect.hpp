@@ -68,8 +68,7 @@ class ParticleEffect : public Effect {
   // V, dV/dx and the Hessian values (in pattern order) at the gathered coordinates.
   virtual void potential(const double* x, double* value, double* gradient, double* hessian) const = 0;
   // V and dV/dx at jets, for the shooting construction: an effect that gives it also returns true
-  // from evaluates_at_jets(). Write V and dV/dx once as a template on the scalar (double or Jet2)
-  // and call it from both potential() and here (the bundled effects do: plugins/effect/).
+  // from evaluates_at_jets(). TemplatedEffect below does both from V and dV/dx written once.
   virtual void potential_jet(const Jet2* /*x*/, Jet2* /*value*/, Jet2* /*gradient*/) const {
     throw std::logic_error("this effect does not evaluate at jets");
   }
@@ -110,6 +109,29 @@ class ParticleEffect : public Effect {
  private:
   std::vector<int> indices_, rows_, cols_;
   std::string error_;
+};
+
+// An effect whose V and dV/dx are written once as a template on the scalar (double or Jet2), so
+// that it serves the shooting construction as well: Derived implements
+//   template <class T> void first_order(const T* x, T* value, T* gradient) const;
+//   void second_order(const double* x, double* hessian) const;  // Hessian values, pattern order
+// (value or gradient may be null) and declares `friend varia::sdk::TemplatedEffect<Derived>;`.
+template <class Derived>
+class TemplatedEffect : public ParticleEffect {
+ public:
+  bool evaluates_at_jets() const noexcept final { return true; }
+
+ protected:
+  void potential(const double* x, double* value, double* gradient, double* hessian) const final {
+    derived().first_order(x, value, gradient);
+    if (hessian != nullptr) derived().second_order(x, hessian);
+  }
+  void potential_jet(const Jet2* x, Jet2* value, Jet2* gradient) const final {
+    derived().first_order(x, value, gradient);
+  }
+
+ private:
+  const Derived& derived() const { return static_cast<const Derived&>(*this); }
 };
 
 }  // namespace varia::sdk
