@@ -80,8 +80,13 @@ TEST_CASE("every example scene runs, writing the spec's CSV header and run recor
   }
 }
 
-TEST_CASE("every example scene validates") {
-  for (const auto& file : files_in(kSourceDir / "scenes", ".json")) {
+TEST_CASE("every example scene validates, in scenes/ and its directories (scenes/bad/ is refused by design)") {
+  std::vector<fs::path> scenes = files_in(kSourceDir / "scenes", ".json");
+  for (const auto& entry : fs::directory_iterator(kSourceDir / "scenes"))
+    if (entry.is_directory() && entry.path().filename() != "bad")
+      for (const auto& file : files_in(entry.path(), ".json")) scenes.push_back(file);
+  CHECK(scenes.size() > 40);
+  for (const auto& file : scenes) {
     CAPTURE(file);
     const auto outcome = run_varia("validate '" + file.string() + "'");
     CAPTURE(outcome.err);
