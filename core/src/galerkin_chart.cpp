@@ -49,13 +49,13 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
       weights_(Eigen::Map<const Eigen::VectorXd>(quadrature.weights(), quadrature.size())),
       options_(options),
       solver_(options),
-      reduced_(reduced),
+      reduced_(reduced || invariant_under_the_whole_group(lagrangian, manifold.dim())),
       m_(manifold.point_size()),
       n_(manifold.dim()),
       s_(static_cast<int>(control_times.size()) - 1) {
   if (lagrangian.position_size() != m_ || lagrangian.velocity_size() != n_)
     throw std::invalid_argument("the Lagrangian's sizes do not match the manifold's");
-  if (reduced_ && !invariant_under_the_whole_group(lagrangian, n_))
+  if (reduced && !invariant_under_the_whole_group(lagrangian, n_))
     throw std::invalid_argument(
         "the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group "
         "(declared symmetry '" + std::string(lagrangian.symmetry_group()) + "' with " +

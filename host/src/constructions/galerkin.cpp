@@ -79,7 +79,8 @@ class Galerkin final : public Construction {
          {"reduced",
           {{"description",
             "on a Lie group: solve the reduced (higher-order discrete Euler-Poincare) equations; needs a "
-            "Lagrangian invariant under the whole group"},
+            "Lagrangian invariant under the whole group, for which the step takes them whether asked or not "
+            "(the same equations, without position jets)"},
            {"type", "boolean"}}}},
         {"quadrature", "degree"});
   }

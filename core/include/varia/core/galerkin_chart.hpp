@@ -23,6 +23,10 @@
 // Euler-Poincare equations dexp_{xi^s}^{-T} sigma = p0 (the right-trivialized l_d'(f) = p0,
 // f = exp(xi^s)) with the internal conditions, evaluating l(Omega) = L(g0, Omega) and no position
 // derivative, then reconstructs g1 = g0 f and p1 = dexp_{-xi^s}^{-T} sigma = Ad*_f p0.
+// These are the step's equations above with tau = 0 and L(g0 exp(xi), Omega) = L(g0, Omega), so
+// the map takes the reduced form's evaluation for every such Lagrangian: the position jets would
+// add exact zeros, and took a third of a step (issue #19). `reduced` asks for it and throws where
+// it does not apply.
 #pragma once
 
 #include <Eigen/Core>
