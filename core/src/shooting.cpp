@@ -22,9 +22,12 @@ Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingFo
                                 "(the Euler-Lagrange field on TQ) only");
   if (!lagrangian.evaluates_at_jets())
     throw std::invalid_argument("the shooting construction propagates jets through the Euler-Lagrange field, and "
-                                "this Lagrangian does not evaluate at jets (models derived from "
-                                "sdk::AutodiffLagrangian or sdk::TermwiseLagrangian do, and a composite Lagrangian "
-                                "whose effects all do: Effect::gradient_jet)");
+                                "this Lagrangian (" +
+                                std::to_string(lagrangian.position_size() + lagrangian.velocity_size()) +
+                                " position and velocity numbers) does not evaluate at jets (models derived from "
+                                "sdk::AutodiffLagrangian do for at most sdk::kStackVariables = 18 position and "
+                                "velocity numbers together, sdk::TermwiseLagrangian at any size, and a composite "
+                                "Lagrangian whose effects all do: Effect::gradient_jet)");
   if (!manifold.is_vector_space() && 2 * manifold.dim() > kMaxJetVariables)
     throw std::invalid_argument("the shooting construction on a Lie group differentiates the propagation with "
                                 "jets of at most " + std::to_string(kMaxJetVariables) +

@@ -74,7 +74,9 @@ class AutodiffLagrangian : public Lagrangian {
     });
   }
 
-  bool evaluates_at_jets() const noexcept final { return true; }
+  // At jets the model runs at dual numbers on the stack: up to kStackVariables numbers (q, v). Above
+  // that the shooting construction refuses the Lagrangian when it is built (validate, exit 2).
+  bool evaluates_at_jets() const noexcept final { return m_ + n_ <= kStackVariables; }
   Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final {
     return guarded(error_, [&] {
       if (m_ + n_ > kStackVariables)
