@@ -1,7 +1,8 @@
 // Scaling of the sparse Galerkin construction (docs/effects.md): a chain of N particles in 3-D,
 // the first tied to the origin, each joined to the next by a spring, under gravity, for N from 10
 // to 1000. Prints the time per step against N and the exponent a of time ~ N^a fitted by least
-// squares in log-log (about 1: the banded Newton Jacobian is factorized by sparse LU).
+// squares in log-log (about 1: degree 1 with the trapezoid rule is explicit, M factorized once by
+// sparse Cholesky).
 //   build/bin/bench_chain_scaling [steps per N, default 20]
 #include <fmt/format.h>
 

@@ -129,10 +129,8 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   for (std::size_t e = 0; e < forces_.rows().size(); ++e)
     entries_.push_back(Entry{forces_.rows()[e], forces_.cols()[e] % n_, false, forces_.cols()[e] >= n_});
   action_ = for_dimension(n_, [](auto N) -> ActionFunction { return &GalerkinDiscreteLagrangian::action_for<decltype(N)::value>; });
-  if (explicit_form_applies(quadrature))
-    explicit_advance_ = for_dimension(
-        n_, [](auto N) -> AdvanceFunction { return &GalerkinDiscreteLagrangian::explicit_advance<decltype(N)::value>; });
-  else if (simplified_applies())
+  explicit_advance_ = explicit_form(quadrature);
+  if (explicit_advance_ == nullptr && simplified_applies())
     for_dimension(n_, [this](auto N) {
       simplified_solve_ = &GalerkinDiscreteLagrangian::solve_simplified<decltype(N)::value>;
       predict_ = &GalerkinDiscreteLagrangian::predict<decltype(N)::value>;
@@ -145,12 +143,13 @@ const EvaluationCounters& GalerkinDiscreteLagrangian::evaluations() const {
   return counters_;
 }
 
-// Not with forces (f(v) makes the equations implicit) nor for a sparse Lagrangian (the explicit
-// form factorizes a dense mass matrix).
-bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
-  if (!forces_.empty() || lagrangian_.sparse()) return false;
-  mass_matrix_.resize(n_, n_);
-  if (s_ != 1 || !lagrangian_.plugin().constant_mass_matrix(mass_matrix_.data())) return false;
+// The explicit form's steps where its equations are explicit: degree 1, nodes at 0 and 1 only,
+// no forces (f(v) makes them implicit), a constant mass matrix M, symmetric positive definite (the
+// Lagrangian hyperregular). explicit_advance<N> for a dense Lagrangian (M from
+// constant_mass_matrix, M^{-1} formed once); sparse_explicit_advance for a sparse one that
+// declares has_constant_mass_matrix (M factorized at the first step); else null.
+GalerkinDiscreteLagrangian::AdvanceFunction GalerkinDiscreteLagrangian::explicit_form(Quadrature& quadrature) {
+  if (!forces_.empty() || s_ != 1) return nullptr;
   for (int i = 0; i < quadrature.size(); ++i) {
     const double c = quadrature.nodes()[i], b = quadrature.weights()[i];
     if (b == 0.0) continue;
@@ -159,17 +158,22 @@ bool GalerkinDiscreteLagrangian::explicit_form_applies(Quadrature& quadrature) {
     else if (c == 1.0)
       b1_ += b;
     else
-      return false;
+      return nullptr;
   }
-  // M symmetric positive definite (the Lagrangian hyperregular); M^{-1} is formed once.
-  const Eigen::LLT<Eigen::MatrixXd> mass(mass_matrix_);
-  if (mass.info() != Eigen::Success) return false;
-  inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
   force_.resize(n_);
   increment_.resize(n_);
   last_q_.resize(n_);
   last_p_.resize(n_);
-  return true;
+  if (lagrangian_.sparse())
+    return lagrangian_.plugin().has_constant_mass_matrix() ? &GalerkinDiscreteLagrangian::sparse_explicit_advance
+                                                           : nullptr;
+  mass_matrix_.resize(n_, n_);
+  if (!lagrangian_.plugin().constant_mass_matrix(mass_matrix_.data())) return nullptr;
+  const Eigen::LLT<Eigen::MatrixXd> mass(mass_matrix_);
+  if (mass.info() != Eigen::Success) return nullptr;
+  inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
+  return for_dimension(
+      n_, [](auto N) -> AdvanceFunction { return &GalerkinDiscreteLagrangian::explicit_advance<decltype(N)::value>; });
 }
 
 // A constant mass matrix, no forces (f(v) would add to the kinetic part), a dense Jacobian; M
@@ -278,6 +282,58 @@ void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h
   previous_h_ = h;
   has_force_ = true;
   statistics_.solves += steps;  // explicit: no Newton iterations
+}
+
+// The explicit form's steps for a sparse Lagrangian: explicit_advance's recurrence (q += h v,
+// f = dL/dq(q), h v += h^2 (b0 + b1) M^{-1} f, then p = M (h v) / h - h b0 f), with M^{-1} f by
+// the sparse Cholesky factor of M: linear in M's entries per step, no Newton iteration (a chain
+// of N particles: M diagonal). M is read at the first step from the Hessian's velocity block
+// (constant, so any point gives it) and factorized once, in natural order: no permutation, which
+// a solve would apply through a temporary.
+void GalerkinDiscreteLagrangian::sparse_explicit_advance(double* q, double* p, double h, long steps) {
+  if (steps <= 0) return;
+  if (sparse_mass_.rows() == 0) factorize_sparse_mass(q);
+  Eigen::Map<Eigen::VectorXd> position(q, n_), momentum(p, n_);
+  const bool same_q = has_force_ && last_q_ == position;
+  if (!same_q) {
+    lagrangian_.gradient(q, v_.data(), grad_.data());  // dL/dq does not depend on v here
+    force_ = grad_.head(n_);
+  }
+  const double kick0 = h * b0_, kick = h * h * (b0_ + b1_);
+  if (!(same_q && last_p_ == momentum && previous_h_ == h)) {
+    velocity_ = momentum + kick0 * force_;  // M v
+    increment_ = sparse_mass_solver_.solve(velocity_);
+    increment_ *= h;
+  }
+  for (long k = 0; k < steps; ++k) {
+    position += increment_;
+    lagrangian_.gradient(q, v_.data(), grad_.data());
+    force_ = grad_.head(n_);
+    velocity_ = sparse_mass_solver_.solve(force_);  // M^{-1} dL/dq (workspace)
+    increment_ += kick * velocity_;
+  }
+  momentum.noalias() = sparse_mass_ * increment_;
+  momentum /= h;
+  momentum -= kick0 * force_;
+  last_q_ = position;
+  last_p_ = momentum;
+  previous_h_ = h;
+  has_force_ = true;
+  statistics_.solves += steps;  // explicit: no Newton iterations
+}
+
+void GalerkinDiscreteLagrangian::factorize_sparse_mass(const double* q) {
+  lagrangian_.sparse_hessian(q, v_.data(), grad_.data(), sparse_values_.data());
+  std::vector<Eigen::Triplet<double>> triplets;
+  for (int e = 0; e < lagrangian_.pattern_size(); ++e)
+    if (entries_[e].row_v && entries_[e].col_v) triplets.emplace_back(entries_[e].row, entries_[e].col, sparse_values_[e]);
+  sparse_mass_.resize(n_, n_);
+  sparse_mass_.setFromTriplets(triplets.begin(), triplets.end());
+  sparse_mass_solver_.compute(sparse_mass_);
+  if (sparse_mass_solver_.info() != Eigen::Success)
+    throw NumericalFailure("the Lagrangian's constant mass matrix (its Hessian's velocity block) is not positive "
+                           "definite: the Lagrangian is not regular",
+                           NAN);
 }
 
 void GalerkinDiscreteLagrangian::take_steps(double* q, double* p, double t0, double h, long steps, double* q1,

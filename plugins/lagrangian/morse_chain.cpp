@@ -60,6 +60,7 @@ class MorseChain final : public varia::sdk::TermwiseLagrangian {
     varia::plugins::write_scaled_identity(mass, velocity_size(), mass_);
     return true;
   }
+  bool has_constant_mass_matrix() const noexcept override { return true; }
 
  private:
   static int dimension(const varia::sdk::Context& context) {

@@ -94,6 +94,16 @@ TEST_CASE("galerkin steps allocate nothing: explicit form, simplified Newton and
   }
 }
 
+TEST_CASE("galerkin's explicit form for a sparse Lagrangian allocates nothing per step") {
+  const int n = 5;
+  FlatSpace space(n);
+  SparseChain chain(n, true);
+  auto trapezoid_rule = trapezoid();
+  GalerkinDiscreteLagrangian verlet(space, chain, trapezoid_rule, equispaced_control_times(1), {});
+  CHECK(allocations_of_steps(verlet, n) == 0);
+  CHECK(verlet.solver_statistics().max_iterations == 0);
+}
+
 // SO(3) through the SDK's generic adapter (no tuned chart): each simplified Newton iteration asks
 // the chart for first derivatives only, at first-order duals on the stack.
 class AdapterRotations final : public sdk::LieGroupManifold<sdk::groups::Rotations> {

@@ -9,6 +9,7 @@
 #include "varia/core/so3.hpp"
 #include "varia/sdk/autodiff_lagrangian.hpp"
 #include "varia/sdk/groups/so3.hpp"
+#include "varia/sdk/termwise_lagrangian.hpp"
 
 namespace varia::testing {
 
@@ -115,6 +116,27 @@ struct SeparablePendulum : Pendulum {
     mass[0] = 1.0;
     return true;
   }
+};
+
+// n unit masses on a line, neighbours joined by anharmonic springs (V = d^2/2 + d^4/4, d the
+// stretch past length 1), written term-wise: a sparse Lagrangian (the Hessian's pattern from the
+// terms). Declared (has_constant_mass_matrix) or not, to compare the explicit form with Newton.
+struct SparseChain : sdk::TermwiseLagrangian {
+  SparseChain(int n, bool declared) : TermwiseLagrangian(n, n), declared_(declared) {
+    for (int i = 0; i < n; ++i)
+      add_term([]<class T>(const sdk::TermVec<T, 1>& x) -> T { return 0.5 * x(0) * x(0); }, {velocity(i)});
+    for (int i = 0; i + 1 < n; ++i)
+      add_term(
+          []<class T>(const sdk::TermVec<T, 2>& x) -> T {
+            const T d = x(1) - x(0) - 1.0;
+            return -(0.5 * d * d + 0.25 * d * d * d * d);
+          },
+          {position(i), position(i + 1)});
+  }
+  bool has_constant_mass_matrix() const noexcept override { return declared_; }
+
+ private:
+  bool declared_;
 };
 
 }  // namespace varia::testing

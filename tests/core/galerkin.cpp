@@ -108,6 +108,34 @@ TEST_CASE("galerkin explicit form for a constant mass matrix agrees with the New
   CHECK(newton.solver_statistics().max_iterations >= 1);
 }
 
+TEST_CASE("galerkin explicit form for a sparse Lagrangian with a constant mass matrix: the Newton solve's steps, no Newton iteration (issue #18)") {
+  const int n = 6;
+  FlatSpace space(n);
+  SparseChain declared(n, true), undeclared(n, false);
+  auto rule = trapezoid();
+  GalerkinDiscreteLagrangian newton(space, undeclared, rule, equispaced_control_times(1), {});
+  GalerkinDiscreteLagrangian direct(space, declared, rule, equispaced_control_times(1), {});
+  Eigen::VectorXd a(2 * n), b(2 * n), next(2 * n);
+  for (int i = 0; i < n; ++i) a(i) = 1.05 * i + 0.1 * std::sin(i);  // stretched springs, at rest
+  a.tail(n).setZero();
+  b = a;
+  const long steps = 1000;
+  for (long k = 0; k < steps; ++k) {
+    newton.step(a.data(), a.data() + n, 0.05, next.data(), next.data() + n);
+    a = next;
+    direct.step(b.data(), b.data() + n, 0.05, next.data(), next.data() + n);
+    b = next;
+  }
+  CAPTURE((a - b).cwiseAbs().maxCoeff());
+  CHECK((a - b).cwiseAbs().maxCoeff() < 1e-11);
+  CHECK((a.head(n) - Eigen::VectorXd::LinSpaced(n, 0, 1.05 * (n - 1))).cwiseAbs().maxCoeff() > 1e-3);  // it moved
+  CHECK(direct.solver_statistics().max_iterations == 0);
+  CHECK(newton.solver_statistics().max_iterations >= 1);
+  // One gradient a step (plus the first), and one Hessian, at the first step, for M.
+  CHECK(direct.evaluations().gradient == steps + 1);
+  CHECK(direct.evaluations().hessian == 1);
+}
+
 // advance() (the loop varia cost and the benchmarks time) must be the steps of step(), to the
 // bit: the explicit form's register loop at n = 1, 2 and 5, and the default loop (Newton) for a
 // Lagrangian that declares no constant mass matrix.

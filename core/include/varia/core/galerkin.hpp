@@ -20,12 +20,16 @@
 //   f_d^nu = h sum_i b_i l_nu(c_i) f(t + c_i h, q(c_i h), qdot(c_i h)),
 // added to the equation of control point nu: p0 = -D1 L_d - f_d^0, p1 = D2 L_d + f_d^s.
 // A Lagrangian with a sparse Hessian (hessian_pattern() >= 0) gets a sparse Newton Jacobian,
-// factorized by Eigen's SparseLU; no dense matrix of size n is formed.
+// factorized by Eigen's SparseLU; no dense matrix of size n is formed. Degree 1 with the nodes at
+// 0 and 1 only and a constant mass matrix (constant_mass_matrix for a dense Lagrangian,
+// has_constant_mass_matrix for a sparse one) takes no Newton iteration: its equations are
+// explicit (Stormer-Verlet for the trapezoid rule).
 #pragma once
 
 #include <Eigen/Core>
 #include <Eigen/Cholesky>
 #include <Eigen/LU>
+#include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 #include <vector>
@@ -136,13 +140,16 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void gradient_after_update(double h, int first_unknown, const Eigen::VectorXd& update, bool forced);
   void warm_start(const double* q0, const double* p0, double h);
   // Degree 1 with nodes only at 0 and 1 and a constant mass matrix M: the IDEL equations are
-  // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton. The steps are
-  // compiled for N = n (fixed-size arithmetic, the state in registers across steps) when n <= 4,
-  // for Eigen::Dynamic otherwise, and chosen once.
-  bool explicit_form_applies(Quadrature& quadrature);
+  // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton. For a dense
+  // Lagrangian the steps are compiled for N = n (fixed-size arithmetic, the state in registers
+  // across steps) when n <= 4, for Eigen::Dynamic otherwise; for a sparse one M is factorized by
+  // sparse Cholesky. Chosen once.
+  using AdvanceFunction = void (GalerkinDiscreteLagrangian::*)(double*, double*, double, long);
+  AdvanceFunction explicit_form(Quadrature& quadrature);
   template <int N>
   void explicit_advance(double* q, double* p, double h, long steps);
-  using AdvanceFunction = void (GalerkinDiscreteLagrangian::*)(double*, double*, double, long);
+  void sparse_explicit_advance(double* q, double* p, double h, long steps);
+  void factorize_sparse_mass(const double* q);
 
   LagrangianEvaluator lagrangian_;
   Forces forces_;
@@ -212,6 +219,8 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::VectorXd predicted_, kinetic_;
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;
+  Eigen::SparseMatrix<double> sparse_mass_;  // the sparse explicit form's M, and its Cholesky factor
+  Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> sparse_mass_solver_;
   Eigen::VectorXd force_, increment_, last_q_, last_p_;
   bool has_force_ = false;
 };

@@ -26,6 +26,10 @@ class Lagrangian : public PluginObject {
   // L = 1/2 v^T M v - V(q) with a constant mass matrix M: fills M (n x n, column-major) and
   // returns true. The constructions may then use explicit forms of their equations.
   virtual bool constant_mass_matrix(double* /*mass*/) const noexcept { return false; }
+  // Whether L = 1/2 v^T M v - V(q) with a constant M, without writing M: for a sparse Lagrangian,
+  // whose M (its Hessian's vv entries at any point) would not fit an n x n buffer. The Galerkin
+  // construction then takes the explicit form where its equations are explicit. ABI 12.
+  virtual bool has_constant_mass_matrix() const noexcept { return false; }
   // L and its gradient [dL/dq, dL/dv] at jet inputs (q, v): the jets of L(q(x), v(x)) and of its
   // gradient for the jet variables x (value may be null). The shooting construction integrates
   // the Euler-Lagrange vector field at jets with it (paper, sec. 3). The SDK's

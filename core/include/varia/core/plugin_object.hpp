@@ -18,8 +18,8 @@ namespace varia {
 // jets), Manifold::has_constraint, Lagrangian::evaluates_at_jets, PluginObject::origin;
 // 7: Manifold::translate, Manifold::generators; 9: Manifold::has_increment, Manifold::increment;
 // 10: Lagrangian::hessian_jet, Lagrangian::hessian_jet_variables.
-// 11: Effect::gradient_jet, Effect::evaluates_at_jets.
-inline constexpr int kAbiVersion = 11;
+// 11: Effect::gradient_jet, Effect::evaluates_at_jets; 12: Lagrangian::has_constant_mass_matrix.
+inline constexpr int kAbiVersion = 12;
 
 using Status = const char*;
 

@@ -161,6 +161,17 @@ inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q
     failures.expect(e.hessian.bottomLeftCorner(n, m).cwiseAbs().maxCoeff() < 1e-13,
                     "a constant mass matrix is declared but d2L/dv dq is not zero");
   }
+  if (lagrangian.has_constant_mass_matrix()) {
+    // Read off the Hessian (a sparse Lagrangian gives no dense M): d2L/dv dq zero and d2L/dv2 the
+    // same at another point.
+    const Evaluation other =
+        evaluate(lagrangian, (0.5 * q.array() + 0.3).matrix(), (-0.7 * v.array() + 0.1).matrix());
+    failures.expect((e.hessian.bottomRightCorner(n, n) - other.hessian.bottomRightCorner(n, n)).cwiseAbs().maxCoeff() <
+                        1e-13 * h_scale,
+                    "has_constant_mass_matrix() is declared but d2L/dv2 changes from point to point");
+    failures.expect(e.hessian.bottomLeftCorner(n, m).cwiseAbs().maxCoeff() < 1e-13 * h_scale,
+                    "has_constant_mass_matrix() is declared but d2L/dv dq is not zero");
+  }
   if (lagrangian.momentum_size() > 0) check_symmetry(lagrangian, seed, q, v, e.value, failures);
   check_jets(lagrangian, seed, q, v, failures);
 }
