@@ -43,49 +43,59 @@ CompositeLagrangian::Term CompositeLagrangian::bind(std::shared_ptr<Effect> effe
   const int *rows = nullptr, *cols = nullptr;
   const int entries = effect->hessian_pattern(&rows, &cols);
   for (int e = 0; e < entries; ++e) term.slots.push_back(pattern_.slot(term.indices[rows[e]], term.indices[cols[e]]));
-  term.x.resize(k);
-  term.gradient.resize(k);
+  term.at_doubles.x.resize(k);
+  term.at_doubles.gradient.resize(k);
   term.hessian.resize(entries);
   term.effect = std::move(effect);
   return term;
 }
 
-// Gathers the term's coordinates x_j = q[indices_j], and scatters -V, -dV/dx and -d2V/dx2 into
-// L's value, dL/dq and Hessian slots.
-void CompositeLagrangian::add_term(Term& term, const double* q, double* value, double* gradient,
-                                   double* hessian) {
-  const int k = static_cast<int>(term.x.size());
-  for (int j = 0; j < k; ++j) term.x[j] = q[term.indices[j]];
-  double V = 0.0;
-  if (Status status = term.effect->evaluate(term.x.data(), value ? &V : nullptr,
-                                            gradient ? term.gradient.data() : nullptr,
-                                            hessian ? term.hessian.data() : nullptr))
-    throw std::runtime_error(std::string("effect: ") + status);
-  if (value != nullptr) *value -= V;
+// L = 1/2 sum_j m_j v_j^2 - sum_e V_e and dL/dq = -sum_e dV_e/dq, dL/dv_j = m_j v_j, at doubles
+// (with d2L/dv_j^2 = m_j, d2L/dq2 = -sum_e d2V_e/dq2 when hessian is not null) or at jets (the
+// effects' gradient_jet; hessian null). Each term gathers its coordinates x_j = q[indices_j] and
+// scatters -V, -dV/dx and -d2V/dx2 into L's value, dL/dq and Hessian slots.
+template <class T>
+void CompositeLagrangian::sum_terms(const T* q, const T* v, T* value, T* gradient, double* hessian) {
+  if (value != nullptr) {
+    *value = T(0.0);
+    for (int j = 0; j < n_; ++j) *value += 0.5 * masses_[j] * v[j] * v[j];
+  }
   if (gradient != nullptr)
-    for (int j = 0; j < k; ++j) gradient[term.indices[j]] -= term.gradient[j];
-  if (hessian != nullptr)
-    for (std::size_t e = 0; e < term.slots.size(); ++e) hessian[term.slots[e]] -= term.hessian[e];
+    for (int j = 0; j < n_; ++j) {
+      gradient[j] = T(0.0);
+      gradient[n_ + j] = masses_[j] * v[j];
+    }
+  if (hessian != nullptr) {
+    std::fill(hessian + n_, hessian + pattern_.size(), 0.0);
+    std::copy(masses_.begin(), masses_.end(), hessian);
+  }
+  for (Term& term : terms_) {
+    const std::size_t k = term.at_doubles.x.size();
+    std::vector<T>& x = term.template buffers<T>().x;
+    std::vector<T>& dV = term.template buffers<T>().gradient;
+    x.resize(k);  // at jets: sized at the first evaluation, then a no-op
+    dV.resize(k);
+    for (std::size_t j = 0; j < k; ++j) x[j] = q[term.indices[j]];
+    T V(0.0);
+    Status status;
+    if constexpr (std::is_same_v<T, double>)
+      status = term.effect->evaluate(x.data(), value ? &V : nullptr, gradient ? dV.data() : nullptr,
+                                     hessian ? term.hessian.data() : nullptr);
+    else
+      status = term.effect->gradient_jet(x.data(), value ? &V : nullptr, dV.data());
+    if (status != nullptr) throw std::runtime_error(std::string("effect: ") + status);
+    if (value != nullptr) *value -= V;
+    if (gradient != nullptr)
+      for (std::size_t j = 0; j < k; ++j) gradient[term.indices[j]] -= dV[j];
+    if (hessian != nullptr)
+      for (std::size_t e = 0; e < term.slots.size(); ++e) hessian[term.slots[e]] -= term.hessian[e];
+  }
 }
 
-// L = 1/2 sum_j m_j v_j^2 - sum_e V_e: dL/dq = -sum_e dV_e/dq, dL/dv_j = m_j v_j,
-// d2L/dv_j^2 = m_j, d2L/dq2 = -sum_e d2V_e/dq2.
 Status CompositeLagrangian::evaluate(const double* q, const double* v, double* value,
                                      double* gradient, double* hessian) noexcept {
   try {
-    if (value != nullptr) {
-      *value = 0.0;
-      for (int j = 0; j < n_; ++j) *value += 0.5 * masses_[j] * v[j] * v[j];
-    }
-    if (gradient != nullptr) {
-      std::fill(gradient, gradient + n_, 0.0);
-      for (int j = 0; j < n_; ++j) gradient[n_ + j] = masses_[j] * v[j];
-    }
-    if (hessian != nullptr) {
-      std::fill(hessian + n_, hessian + pattern_.size(), 0.0);
-      std::copy(masses_.begin(), masses_.end(), hessian);
-    }
-    for (Term& term : terms_) add_term(term, q, value, gradient, hessian);
+    sum_terms(q, v, value, gradient, hessian);
     return nullptr;
   } catch (const std::exception& e) {
     error_ = e.what();
@@ -97,28 +107,9 @@ bool CompositeLagrangian::evaluates_at_jets() const noexcept {
   return std::all_of(terms_.begin(), terms_.end(), [](const Term& term) { return term.effect->evaluates_at_jets(); });
 }
 
-// The same sums at jets: dL/dq = -sum_e dV_e/dq at jets, dL/dv_j = m_j v_j.
 Status CompositeLagrangian::gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept {
   try {
-    if (value != nullptr) {
-      *value = Jet2(0.0);
-      for (int j = 0; j < n_; ++j) *value += (0.5 * masses_[j]) * (v[j] * v[j]);
-    }
-    for (int j = 0; j < n_; ++j) {
-      gradient[j] = Jet2(0.0);
-      gradient[n_ + j] = masses_[j] * v[j];
-    }
-    for (Term& term : terms_) {
-      const std::size_t k = term.x.size();
-      term.x_jets.resize(k);
-      term.gradient_jets.resize(k);
-      for (std::size_t j = 0; j < k; ++j) term.x_jets[j] = q[term.indices[j]];
-      Jet2 V;
-      if (Status status = term.effect->gradient_jet(term.x_jets.data(), value ? &V : nullptr, term.gradient_jets.data()))
-        throw std::runtime_error(std::string("effect: ") + status);
-      if (value != nullptr) *value -= V;
-      for (std::size_t j = 0; j < k; ++j) gradient[term.indices[j]] -= term.gradient_jets[j];
-    }
+    sum_terms(q, v, value, gradient, nullptr);
     return nullptr;
   } catch (const std::exception& e) {
     error_ = e.what();

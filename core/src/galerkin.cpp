@@ -277,11 +277,7 @@ void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h
     force = f;
     increment = dk;
   }
-  last_q = position;
-  last_p = momentum;
-  previous_h_ = h;
-  has_force_ = true;
-  statistics_.solves += steps;  // explicit: no Newton iterations
+  keep_explicit_state(q, p, h, steps);
 }
 
 // The explicit form's steps for a sparse Lagrangian: explicit_advance's recurrence (q += h v,
@@ -315,8 +311,14 @@ void GalerkinDiscreteLagrangian::sparse_explicit_advance(double* q, double* p, d
   momentum.noalias() = sparse_mass_ * increment_;
   momentum /= h;
   momentum -= kick0 * force_;
-  last_q_ = position;
-  last_p_ = momentum;
+  keep_explicit_state(q, p, h, steps);
+}
+
+// The explicit form's state after `steps` steps of h ending at (q, p): a call that continues from
+// there reuses dL/dq and the increment (force_, increment_).
+void GalerkinDiscreteLagrangian::keep_explicit_state(const double* q, const double* p, double h, long steps) {
+  last_q_ = Eigen::Map<const Eigen::VectorXd>(q, n_);
+  last_p_ = Eigen::Map<const Eigen::VectorXd>(p, n_);
   previous_h_ = h;
   has_force_ = true;
   statistics_.solves += steps;  // explicit: no Newton iterations

@@ -48,18 +48,25 @@ long allocations_of(F&& f) {
   return allocations - before;
 }
 
-// 50 steps by step() and 50 by advance(), after one step that sizes everything.
-long allocations_of_steps(GalerkinDiscreteLagrangian& map, int n) {
-  Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), p = Eigen::VectorXd::Zero(n), q1(n), p1(n);
-  map.step(q.data(), p.data(), 0.1, q1.data(), p1.data());
+// `steps` steps of h by step() from (q, p), after one step that sizes everything; then, when
+// `advanced`, as many by advance().
+long allocations_of_stepping(DiscreteHamiltonianMap& map, Eigen::VectorXd q, Eigen::VectorXd p, double h, int steps,
+                             bool advanced = false) {
+  Eigen::VectorXd q1(q.size()), p1(p.size());
+  map.step(q.data(), p.data(), h, q1.data(), p1.data());
   return allocations_of([&] {
-    for (int k = 0; k < 50; ++k) {
-      map.step(q1.data(), p1.data(), 0.1, q.data(), p.data());
+    for (int k = 0; k < steps; ++k) {
+      map.step(q1.data(), p1.data(), h, q.data(), p.data());
       q.swap(q1);
       p.swap(p1);
     }
-    map.advance(q.data(), p.data(), 0.1, 50, q1.data(), p1.data());
+    if (advanced) map.advance(q.data(), p.data(), h, steps, q1.data(), p1.data());
   });
+}
+
+// 50 steps by step() and 50 by advance() on R^n.
+long allocations_of_steps(GalerkinDiscreteLagrangian& map, int n) {
+  return allocations_of_stepping(map, Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), Eigen::VectorXd::Zero(n), 0.1, 50, true);
 }
 
 }  // namespace
@@ -116,18 +123,10 @@ TEST_CASE("lie group galerkin steps allocate nothing through the sdk's generic c
   Top top(Eigen::Vector3d(1, 2, 3), 1.0, Eigen::Vector3d(0, 0, 0.5));
   auto rule = lobatto3();
   LieGroupGalerkinDiscreteLagrangian map(group, top, rule, equispaced_control_times(2), {});
-  Eigen::VectorXd R(9), p(3), R1(9), p1(3);
+  Eigen::VectorXd R(9), p(3);
   R << 1, 0, 0, 0, 1, 0, 0, 0, 1;
   p << 0.4, 1.6, -1.8;
-  map.step(R.data(), p.data(), 0.05, R1.data(), p1.data());
-  const long count = allocations_of([&] {
-    for (int k = 0; k < 50; ++k) {
-      map.step(R1.data(), p1.data(), 0.05, R.data(), p.data());
-      R.swap(R1);
-      p.swap(p1);
-    }
-  });
-  CHECK(count == 0);
+  CHECK(allocations_of_stepping(map, R, p, 0.05, 50) == 0);
   CHECK(map.solver_statistics().iterations > 100);
 }
 
@@ -143,16 +142,8 @@ TEST_CASE("shooting steps with a configuration-dependent mass matrix allocate no
       CAPTURE(implicit);
       sdk::RungeKutta method = implicit ? gauss2() : rk4();
       ShootingDiscreteLagrangian map(space, pendulum, rule, method, form, {});
-      double q = 1.3, p = 0.2, q1, p1;
-      map.step(&q, &p, 0.1, &q1, &p1);
-      const long count = allocations_of([&] {
-        for (int k = 0; k < 50; ++k) {
-          map.step(&q1, &p1, 0.1, &q, &p);
-          std::swap(q, q1);
-          std::swap(p, p1);
-        }
-      });
-      CHECK(count == 0);
+      CHECK(allocations_of_stepping(map, Eigen::VectorXd::Constant(1, 1.3), Eigen::VectorXd::Constant(1, 0.2), 0.1,
+                                    50) == 0);
     }
 }
 
@@ -165,15 +156,7 @@ TEST_CASE("shooting steps in passes (R^8, jets of 16 variables over the 12 a jet
     CAPTURE(implicit);
     sdk::RungeKutta method = implicit ? gauss2() : rk4();
     ShootingDiscreteLagrangian map(space, pendulums, rule, method, ShootingForm::lagrangian, {});
-    Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(8, 1.3, 0.2), p = Eigen::VectorXd::Zero(8), q1(8), p1(8);
-    map.step(q.data(), p.data(), 0.1, q1.data(), p1.data());
-    const long count = allocations_of([&] {
-      for (int k = 0; k < 10; ++k) {
-        map.step(q1.data(), p1.data(), 0.1, q.data(), p.data());
-        q.swap(q1);
-        p.swap(p1);
-      }
-    });
-    CHECK(count == 0);
+    CHECK(allocations_of_stepping(map, Eigen::VectorXd::LinSpaced(8, 1.3, 0.2), Eigen::VectorXd::Zero(8), 0.1, 10) ==
+          0);
   }
 }

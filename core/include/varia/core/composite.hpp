@@ -10,6 +10,7 @@
 
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "varia/core/effect.hpp"
@@ -37,16 +38,30 @@ class CompositeLagrangian : public Lagrangian {
   Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final;
 
  private:
-  // One effect with its gathered coordinates and where its Hessian entries go in the pattern.
+  // An effect's gathered coordinates and its gradient there, at one scalar.
+  template <class T>
+  struct Buffers {
+    std::vector<T> x, gradient;
+  };
+  // One effect with its buffers and where its Hessian entries go in the pattern.
   struct Term {
     std::shared_ptr<Effect> effect;
     const int* indices = nullptr;
     std::vector<int> slots;
-    std::vector<double> x, gradient, hessian;
-    std::vector<Jet2> x_jets, gradient_jets;  // sized at the first evaluation at jets
+    Buffers<double> at_doubles;  // sized at bind
+    Buffers<Jet2> at_jets;       // sized at the first evaluation at jets
+    std::vector<double> hessian;
+    template <class T>
+    Buffers<T>& buffers() {
+      if constexpr (std::is_same_v<T, double>)
+        return at_doubles;
+      else
+        return at_jets;
+    }
   };
   Term bind(std::shared_ptr<Effect> effect, std::size_t index);
-  void add_term(Term& term, const double* q, double* value, double* gradient, double* hessian);
+  template <class T>
+  void sum_terms(const T* q, const T* v, T* value, T* gradient, double* hessian);
 
   int d_, n_;
   std::vector<double> masses_;  // one per coordinate: m_i repeated d times

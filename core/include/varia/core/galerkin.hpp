@@ -150,6 +150,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void explicit_advance(double* q, double* p, double h, long steps);
   void sparse_explicit_advance(double* q, double* p, double h, long steps);
   void factorize_sparse_mass(const double* q);
+  void keep_explicit_state(const double* q, const double* p, double h, long steps);
 
   LagrangianEvaluator lagrangian_;
   Forces forces_;
