@@ -175,7 +175,7 @@ void gauss_at_equal_steps(varia::host::Registry& registry, const Exact& exact) {
     rows.push_back({fmt::format("Gauss s = {}, {} steps", s, steps), ns(v.seconds / n),
                     fmt::format("gni_irk2 {}", ns(g.seconds / n)), v.seconds / g.seconds, 1.5});
     notes.push_back(fmt::format("Gauss s = {}, {} steps: errors varia {:.2e}, GNI {:.2e}; final states differ by {:.1e}; "
-                                "evaluations per step varia {:.2f} (Lagrangian plugin calls), GNI {:.2f} (forces)",
+                                "evaluations per step varia {:.2f} (Lagrangian gradients at nodes), GNI {:.2f} (forces)",
                                 s, steps, v.error, g.error, std::max(std::abs(v.q - g.q), std::abs(v.p - g.p)),
                                 v.evaluations_per_step, g.evaluations_per_step));
   }

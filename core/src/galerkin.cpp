@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "varia/core/compensated.hpp"
+#include "varia/core/stormer_verlet.hpp"
 
 namespace varia {
 
@@ -172,6 +173,9 @@ GalerkinDiscreteLagrangian::AdvanceFunction GalerkinDiscreteLagrangian::explicit
   const Eigen::LLT<Eigen::MatrixXd> mass(mass_matrix_);
   if (mass.info() != Eigen::Success) return nullptr;
   inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
+  kick_.resize(n_, n_);
+  verlet_start_.resize(3 * n_);
+  plugin_runs_steps_ = lagrangian_.plugin().runs_verlet_steps();
   return for_dimension(
       n_, [](auto N) -> AdvanceFunction { return &GalerkinDiscreteLagrangian::explicit_advance<decltype(N)::value>; });
 }
@@ -197,6 +201,8 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
   previous_forces_ = node_forces_;
   predicted_.resize(s_ * n_);
   kinetic_.resize((s_ + 1) * n_);
+  node_points_.resize(2 * n_ * r);
+  node_gradients_.resize(2 * n_ * r);
   Eigen::MatrixXd extrapolation = Eigen::MatrixXd::Zero(r, r), weights(r, s_);
   for (int i = 0; i < r; ++i) {
     weights.row(i) = weights_[i] * basis_.phi.col(i).head(s_).transpose();
@@ -217,12 +223,17 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
 // (paper, sec. 2: degree 1 with the trapezoidal rule is Stormer-Verlet), `steps` times in place.
 // The loop carries the position increment h v instead of p: the next step's is
 //   h v' = h M^{-1} (p1 + h b0 dL/dq(q1)) = h v + h^2 (b0 + b1) M^{-1} dL/dq(q1),
-// and p = M (h v) / h - h b0 dL/dq(q) is formed for the caller at the end. The same steps, with
-// round-off of the same size (1e-13 to 1e-12 after 10^6 pendulum steps against a long double
-// run, as for the form above); the chain of dependent operations from one force to the next is
-// three shorter, and the loop's speed is that chain's latency (bench/README.md). The increment
-// and dL/dq are kept for the next call: one that continues from this one's output (q, p and h
-// as left) takes the same steps as one call for both, to the bit, and evaluates no gradient at q.
+// (stormer_verlet.hpp) and p = M (h v) / h - h b0 dL/dq(q) is formed for the caller at the end.
+// The same steps, with round-off of the same size (1e-13 to 1e-12 after 10^6 pendulum steps
+// against a long double run, as for the form above); the chain of dependent operations from one
+// force to the next is three shorter, and the loop's speed is that chain's latency
+// (bench/README.md). The increment and dL/dq are kept for the next call: one that continues from
+// this one's output (q, p and h as left) takes the same steps as one call for both, to the bit,
+// and evaluates no gradient at q.
+// Where the plugin runs the steps itself (Lagrangian::verlet_steps: the SDK's autodiff
+// Lagrangians), the loop crosses the plugin boundary once for all the steps, with the model's
+// dL/dq inlined in it: the same recurrence, the same numbers. Else, or to find the step whose
+// gradient is not finite, the loop here calls the plugin once a step.
 // N is n, or Dynamic. For a fixed N the state (q, h v, dL/dq) is held in local fixed-size vectors
 // across the steps, and the plugin reads q and writes [dL/dq, dL/dv] in one small local array
 // (`io`): a step is a few registers' arithmetic and one plugin call. (With the plugin's input and
@@ -247,17 +258,22 @@ void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h
     velocity_ = momentum + kick0 * force;  // M v (workspace)
     increment.noalias() = h * (inverse * velocity_);
   }
+  Eigen::Map<Matrix> kick(kick_.data(), n_, n_);
+  kick = (h * (kick0 + kick1)) * inverse;  // K = h^2 (b0 + b1) M^{-1}
   // Steps from qk with dk = h v and f = dL/dq(qk), and sets pk at the end; `at` holds q, v (any:
   // dL/dq does not depend on it) and receives the gradient at `gradient`.
-  auto run = [&](const auto& M, const auto& M_inverse, auto& qk, auto& pk, auto& f, auto& dk, auto& at,
-                 double* v, double* gradient) {
+  auto run = [&](const auto& M, const auto& K, auto& qk, auto& pk, auto& f, auto& dk, auto& at, double* v,
+                 double* gradient) {
     const Eigen::Map<const Vector> dLdq(gradient, n_);  // the head of [dL/dq, dL/dv]
-    for (long k = 0; k < steps; ++k) {
-      qk += dk;
-      at = qk;
-      lagrangian_.gradient(at.data(), v, gradient);
-      f = dLdq;
-      dk.noalias() += ((h * (kick0 + kick1)) * M_inverse) * f;  // fixed N: hoisted; dynamic: no temporary
+    Eigen::Map<Vector> q0(verlet_start_.data(), n_), d0(verlet_start_.data() + n_, n_), f0(verlet_start_.data() + 2 * n_, n_);
+    q0 = qk, d0 = dk, f0 = f;
+    if (!plugin_runs_steps_ || !lagrangian_.verlet_steps(qk.data(), dk.data(), f.data(), K.data(), steps)) {
+      qk = q0, dk = d0, f = f0;
+      stormer_verlet_steps(qk, dk, f, K, steps, [&](const auto& x, auto& g) {
+        at = x;
+        lagrangian_.gradient(at.data(), v, gradient);
+        g = dLdq;
+      });
     }
     pk.noalias() = M * dk;
     pk /= h;
@@ -265,13 +281,13 @@ void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h
   };
   if constexpr (N == Eigen::Dynamic) {
     Eigen::Map<Vector> at(q_.data(), n_);
-    run(mass, inverse, position, momentum, force, increment, at, v_.data(), grad_.data());
+    run(mass, kick, position, momentum, force, increment, at, v_.data(), grad_.data());
   } else {
     alignas(64) std::array<double, 4 * N> io{};  // q, v = 0, then [dL/dq, dL/dv]
     Eigen::Map<Vector> at(io.data());
-    const Matrix M = mass, M_inverse = inverse;
+    const Matrix M = mass, K = kick;
     Vector qk = position, pk = momentum, f = force, dk = increment;
-    run(M, M_inverse, qk, pk, f, dk, at, io.data() + N, io.data() + 2 * N);
+    run(M, K, qk, pk, f, dk, at, io.data() + N, io.data() + 2 * N);
     position = qk;
     momentum = pk;
     force = f;
@@ -547,29 +563,29 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
 // K M q^mu / h: K's entries are rounded once, and that rounding, the same at every step, moved the
 // solution by an ulp a step), with p0 added to the equation nu = 0, summed node by node straight
 // into F (issue #19: the step is a chain of dependent passes through memory; a pass into the
-// action's gradient and a copy of it into F made that chain two stores and loads longer). For a
-// fixed N the plugin reads q, v and writes [L_q, L_v] in one small local array, as in
-// explicit_advance. dS/dq^s is summed only for the yardstick (into gradient_'s last block), and
+// action's gradient and a copy of it into F made that chain two stores and loads longer). The
+// nodes are evaluated in one plugin call (Lagrangian::gradients), not one a node. dS/dq^s is summed only for the yardstick (into gradient_'s last block), and
 // dS/dq^0 is kept in gradient_'s first block for finish(). The nodes' forces are kept in
 // node_forces_ for the next step's warm start, impulse_ as in action(). Returns F's round-off
 // yardstick, as Equations::evaluate.
 template <int N>
 double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p0, double* __restrict F) {
   const int n = N == Eigen::Dynamic ? n_ : N, s = s_, r = static_cast<int>(weights_.size());
-  alignas(64) std::array<double, N == Eigen::Dynamic ? 1 : 4 * N> io{};  // q, v, then [L_q, L_v]
-  double* q = N == Eigen::Dynamic ? q_.data() : io.data();
-  double* v = N == Eigen::Dynamic ? v_.data() : io.data() + n;
-  double* dL = N == Eigen::Dynamic ? grad_.data() : io.data() + 2 * n;
+  double* __restrict z = node_points_.data();  // (q_i, v_i) of the nodes of nonzero weight, then
+  double* __restrict gradients = node_gradients_.data();  // their [L_q, L_v]
   double* __restrict last = gradient_.data() + s * n;
   double* __restrict impulse = impulse_.data();
   double* __restrict forces = node_forces_.data();
+  int count = 0;
+  for (int i = 0; i < r; ++i)
+    if (weights_[i] != 0.0) interpolate<N>(i, h, z + 2 * n * count, z + 2 * n * count + n), ++count;
+  lagrangian_.gradients(count, z, gradients);
   for (int k = 0; k < s * n; ++k) F[k] = 0.0;
   for (int c = 0; c < n; ++c) last[c] = impulse[c] = 0.0;
-  for (int i = 0; i < r; ++i) {
+  for (int i = 0, j = 0; i < r; ++i) {
     const double b = weights_[i];
     if (b == 0.0) continue;
-    interpolate<N>(i, h, q, v);
-    lagrangian_.gradient(q, v, dL);
+    const double* dL = gradients + 2 * n * j++;
     for (int c = 0; c < n; ++c) {
       impulse[c] += (h * b) * dL[c];
       forces[i * n + c] = dL[c];

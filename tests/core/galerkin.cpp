@@ -172,6 +172,79 @@ TEST_CASE("galerkin advance takes the same steps as step, bit for bit") {
   compare(newton, 1, false);
 }
 
+namespace {
+
+// A Lagrangian seen through evaluate() and its constant mass matrix only: the explicit form then
+// calls the plugin once a step instead of having it run the steps (Lagrangian::verlet_steps).
+struct EvaluateOnly : Lagrangian {
+  explicit EvaluateOnly(Lagrangian& inner) : inner(inner) {}
+  int position_size() const noexcept override { return inner.position_size(); }
+  int velocity_size() const noexcept override { return inner.velocity_size(); }
+  Status evaluate(const double* q, const double* v, double* value, double* gradient, double* hessian) noexcept override {
+    return inner.evaluate(q, v, value, gradient, hessian);
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override { return inner.constant_mass_matrix(mass); }
+  Lagrangian& inner;
+};
+
+// L = v^2/2 - sqrt(2 - q): pushed towards q = 2, where dL/dq = 1 / (2 sqrt(2 - q)) stops being
+// finite (NaN past it).
+struct Wall : sdk::AutodiffLagrangian<Wall> {
+  Wall() : sdk::AutodiffLagrangian<Wall>(1, 1) {}
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    using std::sqrt;
+    return 0.5 * v(0) * v(0) - sqrt(2.0 - q(0));
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    mass[0] = 1.0;
+    return true;
+  }
+};
+
+}  // namespace
+
+// The explicit form's steps run inside the plugin (the SDK's verlet_steps: one plugin call for all
+// of them) are those of the loop that calls the plugin once a step, to the bit, at the fixed sizes
+// and the dynamic one, with the same gradient count; and where a gradient within them is not
+// finite, advance() fails as that loop does, with the same message.
+TEST_CASE("galerkin explicit form run inside the plugin: the steps of one plugin call a step, bit for bit") {
+  auto rule = trapezoid();
+  for (int n : {1, 3, 5}) {
+    CAPTURE(n);
+    FlatSpace space(n);
+    Pendulums pendulums(n);
+    EvaluateOnly each_step(pendulums);
+    REQUIRE(pendulums.runs_verlet_steps());
+    GalerkinDiscreteLagrangian inside(space, pendulums, rule, equispaced_control_times(1), {});
+    GalerkinDiscreteLagrangian outside(space, each_step, rule, equispaced_control_times(1), {});
+    Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), p = Eigen::VectorXd::Zero(n), a = q, b = p;
+    Eigen::VectorXd q1(n), p1(n);
+    inside.advance(q.data(), p.data(), 0.05, 777, q1.data(), p1.data());
+    outside.advance(a.data(), b.data(), 0.05, 777, q1.data(), p1.data());
+    CHECK((q - Eigen::VectorXd::LinSpaced(n, 1.3, 0.2)).norm() + p.norm() > 0.1);  // it moved
+    CHECK((q.array() == a.array()).all());
+    CHECK((p.array() == b.array()).all());
+    CHECK(inside.evaluations().gradient == outside.evaluations().gradient);
+  }
+  FlatSpace line(1);
+  Wall wall;
+  EvaluateOnly each_step(wall);
+  const auto failure = [&](Lagrangian& lagrangian) {
+    GalerkinDiscreteLagrangian map(line, lagrangian, rule, equispaced_control_times(1), {});
+    double q = 0.0, p = 0.0, q1, p1;
+    try {
+      map.advance(&q, &p, 0.05, 1000, &q1, &p1);
+    } catch (const NumericalFailure& e) {
+      return std::string(e.what());
+    }
+    return std::string("no failure");
+  };
+  const std::string inside = failure(wall), outside = failure(each_step);
+  CHECK(inside.find("gradient") != std::string::npos);
+  CHECK(inside == outside);
+}
+
 // Order 8 (degree 4, 5 Gauss-Lobatto points) on the pendulum from rest at 1.3 to T = 100: at
 // 1376 and 2752 steps the discretization error is below 1e-14, so the two runs must agree to
 // round-off. A solve that stops at a residual of about its tolerance (1e-14 (1 + scale)) leaves

@@ -1,7 +1,8 @@
 // varia-conformance (sdk/tools/varia_conformance.cpp) on effect and force plugins: every bundled
 // effect and force conforms; an effect whose gradient is 1.5 times V's derivative
 // (tests/fault_plugins/wrong_effect_gradient.cpp) is refused, exit 1, with the Taylor test's
-// slope; and the suite, called as a function, refuses a force with a wrong Jacobian entry.
+// slope; and the suites, called as functions, refuse a force with a wrong Jacobian entry and a
+// Lagrangian whose own Stormer-Verlet steps are not the recurrence's.
 #include <doctest/doctest.h>
 
 #include <cstdio>
@@ -9,6 +10,7 @@
 #include <string>
 
 #include "varia/sdk/conformance/force.hpp"
+#include "varia/sdk/conformance/lagrangian.hpp"
 #include "varia/sdk/force_base.hpp"
 
 namespace {
@@ -53,7 +55,57 @@ class QuadraticForce final : public varia::sdk::ForceBase {
   bool wrong_;
 };
 
+// The oscillator L = v.v/2 - q.q/2 on R^2, written by hand (no SDK), that runs the explicit
+// form's Stormer-Verlet steps itself: `wrong` kicks with the force from before the drift
+// (d += K f; q += d; f = -q), a different method.
+class Oscillator final : public varia::Lagrangian {
+ public:
+  explicit Oscillator(bool wrong) : wrong_(wrong) {}
+  int position_size() const noexcept override { return 2; }
+  int velocity_size() const noexcept override { return 2; }
+  varia::Status evaluate(const double* q, const double* v, double* value, double* gradient,
+                         double* hessian) noexcept override {
+    if (value != nullptr) *value = 0.5 * (v[0] * v[0] + v[1] * v[1] - q[0] * q[0] - q[1] * q[1]);
+    if (gradient != nullptr)
+      for (int i = 0; i < 2; ++i) gradient[i] = -q[i], gradient[2 + i] = v[i];
+    if (hessian != nullptr)
+      for (int i = 0; i < 16; ++i) hessian[i] = i % 5 == 0 ? (i < 8 ? -1.0 : 1.0) : 0.0;
+    return nullptr;
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    mass[0] = mass[3] = 1.0, mass[1] = mass[2] = 0.0;
+    return true;
+  }
+  bool runs_verlet_steps() const noexcept override { return true; }
+  varia::Status verlet_steps(double* q, double* d, double* f, const double* K, long steps) noexcept override {
+    for (long k = 0; k < steps; ++k) {
+      if (wrong_)
+        for (int i = 0; i < 2; ++i) d[i] += K[i] * f[0] + K[2 + i] * f[1];
+      for (int i = 0; i < 2; ++i) q[i] += d[i], f[i] = -q[i];
+      if (!wrong_)
+        for (int i = 0; i < 2; ++i) d[i] += K[i] * f[0] + K[2 + i] * f[1];
+    }
+    return nullptr;
+  }
+
+ private:
+  bool wrong_;
+};
+
 }  // namespace
+
+TEST_CASE("the Lagrangian suite refuses a plugin whose own Stormer-Verlet steps kick before the drift, and accepts "
+          "the same plugin with the recurrence's order") {
+  std::mt19937 engine(11);
+  Oscillator right(false), wrong(true);
+  const auto accepted = varia::sdk::conformance::check_lagrangian(right, engine, 5);
+  const std::string first_failure = accepted.empty() ? std::string() : accepted.list()[0];
+  CAPTURE(first_failure);
+  CHECK(accepted.empty());
+  const auto failures = varia::sdk::conformance::check_lagrangian(wrong, engine, 5);
+  REQUIRE(failures.list().size() == 1);
+  CHECK(failures.list()[0].find("verlet_steps gives (q, d, f)") != std::string::npos);
+}
 
 TEST_CASE("varia-conformance: every bundled effect and force plugin conforms, by the Taylor tests of its "
           "derivatives") {

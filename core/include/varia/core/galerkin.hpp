@@ -218,12 +218,18 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::MatrixXd stiffness_, stiffness_inverse_;
   Eigen::MatrixXd node_forces_, previous_forces_, force_prediction_;
   Eigen::VectorXd predicted_, kinetic_;
+  Eigen::VectorXd node_points_, node_gradients_;  // the nodes' (q, v) and [L_q, L_v], 2n each
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;
   Eigen::SparseMatrix<double> sparse_mass_;  // the sparse explicit form's M, and its Cholesky factor
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> sparse_mass_solver_;
   Eigen::VectorXd force_, increment_, last_q_, last_p_;
   bool has_force_ = false;
+  // The dense explicit form: K = h^2 (b0 + b1) M^{-1}, whether the plugin runs the steps itself
+  // (Lagrangian::verlet_steps), and (q, h v, dL/dq) where its steps started, to retake them.
+  Eigen::MatrixXd kick_;
+  bool plugin_runs_steps_ = false;
+  Eigen::VectorXd verlet_start_;
 };
 
 }  // namespace varia

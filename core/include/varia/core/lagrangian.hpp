@@ -18,6 +18,19 @@ class Lagrangian : public PluginObject {
   // z = (q, v) is written densely, column-major (m+n)^2, unless hessian_pattern() says sparse.
   virtual Status evaluate(const double* q, const double* v, double* value, double* gradient,
                           double* hessian) noexcept = 0;
+  // The gradients at `count` points in one call: point i is z_i = (q, v) at points + i (m + n), and
+  // its gradient [dL/dq, dL/dv] goes to gradients + i (m + n). The Galerkin construction evaluates
+  // the quadrature nodes of a step's pass with it (the plugin boundary crossed once a pass, not
+  // once a node). The default calls evaluate() point by point; the SDK's AutodiffLagrangian runs
+  // the points through one loop with the model inlined. ABI 13.
+  virtual Status gradients(int count, const double* points, double* gradients) noexcept {
+    const int k = position_size() + velocity_size();
+    for (int i = 0; i < count; ++i)
+      if (const Status status = evaluate(points + i * k, points + i * k + position_size(), nullptr, gradients + i * k,
+                                         nullptr))
+        return status;
+    return nullptr;
+  }
   // Sparse Hessian: returns the number of stored entries and points rows/cols at their (row, col)
   // indices (lower and upper triangle both stored); -1 (the default) means dense.
   virtual int hessian_pattern(const int** /*rows*/, const int** /*cols*/) const noexcept {
@@ -30,6 +43,17 @@ class Lagrangian : public PluginObject {
   // whose M (its Hessian's vv entries at any point) would not fit an n x n buffer. The Galerkin
   // construction then takes the explicit form where its equations are explicit. ABI 12.
   virtual bool has_constant_mass_matrix() const noexcept { return false; }
+  // The Galerkin construction's explicit form run inside the plugin: `steps` Stormer-Verlet steps
+  // in place (stormer_verlet.hpp: q += d; f = dL/dq(q); d += K f, with q, d, f n numbers and K
+  // n x n, column-major), for a dense L = 1/2 v^T M v - V(q) with m = n. The plugin boundary is
+  // then crossed once for all the steps, not once a step. The numbers must be those of the same
+  // recurrence with dL/dq from evaluate() (the conformance suite checks it); non-finite numbers
+  // are left as they come (the caller checks the result). ABI 13.
+  virtual bool runs_verlet_steps() const noexcept { return false; }
+  virtual Status verlet_steps(double* /*q*/, double* /*d*/, double* /*f*/, const double* /*K*/,
+                              long /*steps*/) noexcept {
+    return "this Lagrangian does not run Stormer-Verlet steps (derive it from sdk::AutodiffLagrangian)";
+  }
   // L and its gradient [dL/dq, dL/dv] at jet inputs (q, v): the jets of L(q(x), v(x)) and of its
   // gradient for the jet variables x (value may be null). The shooting construction integrates
   // the Euler-Lagrange vector field at jets with it (paper, sec. 3). The SDK's

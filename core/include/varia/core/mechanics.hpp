@@ -26,6 +26,9 @@ class LagrangianEvaluator {
   double value(const double* q, const double* v);
   // gradient: m + n numbers [dL/dq, dL/dv]; the plugin is not asked for L.
   void gradient(const double* q, const double* v, double* gradient) { evaluate_gradient(q, v, nullptr, gradient); }
+  // The gradients at `count` points z_i = (q, v) (m + n numbers each) in one plugin call
+  // (Lagrangian::gradients), each counted and checked as gradient() does.
+  void gradients(int count, const double* points, double* gradients);
   // L, and its gradient as above.
   double value_and_gradient(const double* q, const double* v, double* gradient);
   // hessian: (m+n)^2 numbers, dense column-major (sparse Lagrangians are expanded).
@@ -41,6 +44,12 @@ class LagrangianEvaluator {
   void gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient);
   // L's (m+n)^2 Hessian numbers at jet inputs, dense column-major. Counted as a Hessian evaluation.
   void hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian);
+  // `steps` Stormer-Verlet steps run inside the plugin (Lagrangian::verlet_steps, where
+  // plugin().runs_verlet_steps()), counted as that many gradients. False where a result is not
+  // finite: a non-finite gradient makes q non-finite from the next step on, and q stays so, so the
+  // end shows any. q, d, f are then unspecified; the caller retakes the steps a gradient at a time,
+  // which finds the step that fails.
+  bool verlet_steps(double* q, double* d, double* f, const double* K, long steps);
   const EvaluationCounters& counters() const { return counters_; }
 
   // p = dL/dv (q, v).

@@ -18,8 +18,9 @@ namespace varia {
 // jets), Manifold::has_constraint, Lagrangian::evaluates_at_jets, PluginObject::origin;
 // 7: Manifold::translate, Manifold::generators; 9: Manifold::has_increment, Manifold::increment;
 // 10: Lagrangian::hessian_jet, Lagrangian::hessian_jet_variables.
-// 11: Effect::gradient_jet, Effect::evaluates_at_jets; 12: Lagrangian::has_constant_mass_matrix.
-inline constexpr int kAbiVersion = 12;
+// 11: Effect::gradient_jet, Effect::evaluates_at_jets; 12: Lagrangian::has_constant_mass_matrix;
+// 13: Lagrangian::runs_verlet_steps, Lagrangian::verlet_steps, Lagrangian::gradients.
+inline constexpr int kAbiVersion = 13;
 
 using Status = const char*;
 

@@ -18,7 +18,9 @@
 // hold fewer variables than that). Forward mode over forward mode at jet values (jet_tangent.hpp)
 // gives hessian_jet at jets of up to 6 variables, which the shooting construction's lagrangian
 // form needs for a configuration-dependent mass matrix (it propagates in passes of at most that
-// many variables: any dimension up to kStackVariables / 2).
+// many variables: any dimension up to kStackVariables / 2). The same first-order pass, inlined into
+// one loop, gives the gradients at several points in one call (gradients) and runs the Galerkin
+// explicit form's Stormer-Verlet steps inside the plugin (verlet_steps, stormer_verlet.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -29,6 +31,7 @@
 #include <type_traits>
 
 #include "varia/core/lagrangian.hpp"
+#include "varia/core/stormer_verlet.hpp"
 #include "varia/sdk/dual.hpp"
 #include "varia/sdk/jet_tangent.hpp"
 #include "varia/sdk/plugin.hpp"
@@ -71,6 +74,34 @@ class AutodiffLagrangian : public Lagrangian {
         dispatch([&](auto first, auto, auto m) {
           first_order<typename decltype(first)::type, decltype(m)::value, false>(q, v, value, gradient);
         });
+    });
+  }
+
+  // The gradients at several points through one loop with the model inlined (first_order at each).
+  Status gradients(int count, const double* points, double* gradients) noexcept final {
+    return guarded(error_, [&] {
+      const int k = m_ + n_;
+      if (k > kStackVariables) {
+        for (int i = 0; i < count; ++i) chunked_first_order(points + i * k, points + i * k + m_, nullptr, gradients + i * k);
+        return;
+      }
+      dispatch([&](auto first, auto, auto m) {
+        gradients_loop<typename decltype(first)::type, decltype(m)::value>(count, points, gradients);
+      });
+    });
+  }
+
+  // The explicit form's Stormer-Verlet steps with the model inlined in the loop: for m = n and
+  // m + n <= kStackVariables (the dual numbers of first_order).
+  bool runs_verlet_steps() const noexcept final { return m_ == n_ && m_ + n_ <= kStackVariables; }
+  Status verlet_steps(double* q, double* d, double* f, const double* K, long steps) noexcept final {
+    return guarded(error_, [&] {
+      if (!runs_verlet_steps())
+        throw std::length_error("an autodiff Lagrangian runs Stormer-Verlet steps for m = n and at most " +
+                                std::to_string(kStackVariables) + " position and velocity numbers together");
+      dispatch([&](auto first, auto, auto m) {
+        verlet_loop<typename decltype(first)::type, decltype(m)::value>(q, d, f, K, steps);
+      });
     });
   }
 
@@ -162,6 +193,11 @@ class AutodiffLagrangian : public Lagrangian {
   template <class D, int M, bool WithValue>
   [[gnu::noinline, gnu::flatten]] void first_order(const double* q, const double* v, double* value,
                                                    double* gradient) const {
+    first_order_inline<D, M, WithValue>(q, v, value, gradient);
+  }
+  template <class D, int M, bool WithValue>
+  [[gnu::always_inline]] void first_order_inline(const double* q, const double* v, double* value,
+                                                 double* gradient) const {
     constexpr int fixed = D::DerType::SizeAtCompileTime;
     const int k = fixed > 0 ? fixed : m_ + n_;
     const int m = M >= 0 ? M : m_;
@@ -174,6 +210,43 @@ class AutodiffLagrangian : public Lagrangian {
     const D r = model().lagrangian(qd, vd);
     if constexpr (WithValue) *value = r.value();
     for (int i = 0; i < k; ++i) gradient[i] = r.derivatives().size() ? r.derivatives()(i) : 0.0;
+  }
+
+  template <class D, int M>
+  [[gnu::noinline, gnu::flatten]] void gradients_loop(int count, const double* points, double* gradients) const {
+    const int k = m_ + n_;
+    for (int i = 0; i < count; ++i)
+      first_order_inline<D, M, false>(points + i * k, points + i * k + m_, nullptr, gradients + i * k);
+  }
+
+  // verlet_steps with n = M (or m_, for M = Dynamic): the recurrence of stormer_verlet.hpp with
+  // the model's dL/dq inlined (flatten), read at (q, v = 0) from one small local array, as the
+  // core does a step at a time. For a fixed n the state stays in fixed-size vectors.
+  template <class D, int M>
+  [[gnu::noinline, gnu::flatten]] void verlet_loop(double* q, double* d, double* f, const double* K,
+                                                   long steps) const {
+    using Vector = Eigen::Matrix<double, M, 1>;
+    using Matrix = Eigen::Matrix<double, M, M>;
+    const int n = M >= 0 ? M : m_;
+    alignas(64) std::array<double, 2 * kStackVariables> io{}, gradient{};  // (q, v = 0), [dL/dq, dL/dv]
+    auto force = [&](const auto& x, auto& g) {
+      for (int i = 0; i < n; ++i) io[i] = x(i);
+      first_order_inline<D, M, false>(io.data(), io.data() + n, nullptr, gradient.data());
+      g = Eigen::Map<const Vector>(gradient.data(), n);
+    };
+    const Eigen::Map<const Matrix> kick(K, n, n);
+    if constexpr (M == Eigen::Dynamic) {
+      Eigen::Map<Vector> position(q, n), increment(d, n), dLdq(f, n);
+      stormer_verlet_steps(position, increment, dLdq, kick, steps, force);
+    } else {
+      Eigen::Map<Vector> q_out(q), d_out(d), f_out(f);
+      Vector position = q_out, increment = d_out, dLdq = f_out;
+      const Matrix k = kick;
+      stormer_verlet_steps(position, increment, dLdq, k, steps, force);
+      q_out = position;
+      d_out = increment;
+      f_out = dLdq;
+    }
   }
 #pragma GCC diagnostic pop
 

@@ -3,7 +3,9 @@
 // evaluate() path gives the same value; a declared constant mass matrix is the Hessian's velocity
 // block; a declared symmetry leaves L invariant and its momentum map is equivariant; L's gradient
 // and Hessian at jets (gradient_jet, hessian_jet, where the Lagrangian gives them) carry the values
-// at doubles and derivatives that pass Taylor tests against them.
+// at doubles and derivatives that pass Taylor tests against them; gradients() at several points is
+// evaluate() at each; the explicit form's
+// Stormer-Verlet steps, where the plugin runs them itself, are those of the recurrence.
 #pragma once
 
 #include <Eigen/Dense>
@@ -16,6 +18,7 @@
 #include <vector>
 
 #include "varia/core/lagrangian.hpp"
+#include "varia/core/stormer_verlet.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 #include "varia/sdk/conformance/taylor.hpp"
 
@@ -137,6 +140,33 @@ inline void check_jets(Lagrangian& lagrangian, unsigned seed, const VectorXd& q,
         [&](double eps) { return at_doubles(eps).hessian.reshaped().eval(); }, "the Hessian", failures);
 }
 
+// Where the plugin runs the explicit form's Stormer-Verlet steps itself (runs_verlet_steps), five
+// of them from (q, d = h v, f = dL/dq(q)) with K = h^2 M^{-1} (h = 0.1; K = h^2 I without a
+// constant mass matrix: the recurrence is defined all the same) give the numbers of the same
+// recurrence with dL/dq from evaluate(), at v = 0, to round-off.
+inline void check_verlet_steps(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v, Failures& failures) {
+  const int n = lagrangian.velocity_size();
+  if (!lagrangian.runs_verlet_steps() || lagrangian.position_size() != n) return;
+  const double h = 0.1;
+  const long steps = 5;
+  const VectorXd zero = VectorXd::Zero(n);
+  MatrixXd K = MatrixXd::Identity(n, n), mass(n, n);
+  if (lagrangian.constant_mass_matrix(mass.data())) K = mass.llt().solve(K);
+  K *= h * h;
+  VectorXd plugin_q = q, plugin_d = h * v, plugin_f = gradient(lagrangian, q, zero).head(n);
+  VectorXd own_q = plugin_q, own_d = plugin_d, own_f = plugin_f;
+  stormer_verlet_steps(own_q, own_d, own_f, K, steps,
+                       [&](const VectorXd& x, VectorXd& f) { f = gradient(lagrangian, x, zero).head(n); });
+  check(lagrangian, lagrangian.verlet_steps(plugin_q.data(), plugin_d.data(), plugin_f.data(), K.data(), steps),
+        "verlet_steps");
+  const double scale = std::max({1.0, own_q.cwiseAbs().maxCoeff(), own_d.cwiseAbs().maxCoeff() / h,
+                                 own_f.cwiseAbs().maxCoeff()});
+  const double error = std::max({(plugin_q - own_q).cwiseAbs().maxCoeff(), (plugin_d - own_d).cwiseAbs().maxCoeff() / h,
+                                 (plugin_f - own_f).cwiseAbs().maxCoeff()});
+  failures.expect(error <= 1e-13 * scale, "verlet_steps gives (q, d, f) ", error,
+                  " away from the Stormer-Verlet recurrence with dL/dq from evaluate() (5 steps of h = 0.1)");
+}
+
 // The claims at one point (q, v).
 inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q, const VectorXd& v,
                         Failures& failures) {
@@ -154,6 +184,15 @@ inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q
   failures.expect((gradient(lagrangian, q, v) - e.gradient).cwiseAbs().maxCoeff() <=
                       1e-15 * std::max(1.0, e.gradient.cwiseAbs().maxCoeff()),
                   "the gradient alone differs from the gradient with the Hessian");
+  {  // gradients(): at (q, v) and a second point in one call, each as evaluate() gives it
+    const VectorXd q2 = (0.5 * q.array() + 0.3).matrix(), v2 = (-0.7 * v.array() + 0.1).matrix();
+    VectorXd points(2 * (m + n)), both(2 * (m + n)), single(2 * (m + n));
+    points << q, v, q2, v2;
+    single << gradient(lagrangian, q, v), gradient(lagrangian, q2, v2);
+    check(lagrangian, lagrangian.gradients(2, points.data(), both.data()), "gradients");
+    failures.expect((both - single).cwiseAbs().maxCoeff() <= 1e-15 * std::max(1.0, single.cwiseAbs().maxCoeff()),
+                    "gradients() at two points differs from evaluate() at each");
+  }
   MatrixXd mass(n, n);
   if (lagrangian.constant_mass_matrix(mass.data())) {
     failures.expect((e.hessian.bottomRightCorner(n, n) - mass).cwiseAbs().maxCoeff() < 1e-13,
@@ -174,6 +213,7 @@ inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q
   }
   if (lagrangian.momentum_size() > 0) check_symmetry(lagrangian, seed, q, v, e.value, failures);
   check_jets(lagrangian, seed, q, v, failures);
+  check_verlet_steps(lagrangian, q, v, failures);
 }
 
 // The whole suite on one Lagrangian, at `trials` random points.
