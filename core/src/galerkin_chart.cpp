@@ -81,6 +81,12 @@ LieGroupGalerkinDiscreteLagrangian::LieGroupGalerkinDiscreteLagrangian(
   v_.resize(n_);
   grad_.resize(m_ + n_);
   hess_.resize(m_ + n_, m_ + n_);
+  if (reduced_) {  // l(Omega) = 1/2 Omega^T M Omega - V(g0): its Hessian is M (a constant mass matrix), held here
+    Eigen::MatrixXd mass(n_, n_);
+    constant_mass_ = lagrangian.constant_mass_matrix(mass.data());
+    hess_.setZero();
+    if (constant_mass_) hess_.bottomRightCorner(n_, n_) = mass;
+  }
   chain_ = Eigen::MatrixXd::Zero(m_ + n_, 3 * n_);
   hess_chain_.resize(m_ + n_, 3 * n_);
   node_gradient_.resize(3 * n_);
@@ -128,8 +134,11 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
                         {velocity_.data(), velocity_gradient_.data(), with_hessian ? velocity_hessian_.data() : nullptr}));
   for (int k = 0; k < m_; ++k) q_(k) = reduced_ ? q0[k] : point_[k];  // reduced: l = L(g0, .)
   for (int k = 0; k < n; ++k) v_(k) = velocity_[k];
-  const double L = with_hessian ? lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data())
-                                : lagrangian_.value_and_gradient(q_.data(), v_.data(), grad_.data());
+  // The reduced form needs only the velocity block of L's Hessian, d2l/dOmega2, which a declared
+  // constant mass matrix gives without an evaluation (hess_ holds it from the start).
+  const double L = with_hessian && !constant_mass_
+                       ? lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data())
+                       : lagrangian_.value_and_gradient(q_.data(), v_.data(), grad_.data());
   // Row k of the chart's gradient in (eta, xi) or (xi, xi_dot), and its Hessian, as matrices.
   const auto row = [&](const Eigen::VectorXd& gradient, int k) { return gradient.segment(k * 2 * n, 2 * n).transpose(); };
   const auto hessian = [&](const Eigen::VectorXd& h, int k) {

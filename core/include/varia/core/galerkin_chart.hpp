@@ -101,6 +101,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   NewtonSolver solver_;
   SolverStatistics statistics_;
   bool reduced_;
+  bool constant_mass_ = false;  // reduced, and L = 1/2 v^T M v - V(q) declared: hess_'s velocity block is M
   int m_, n_, s_;
   // Workspace, sized once: a step allocates nothing.
   Eigen::MatrixXd xi_;        // n x (s+1) control points in the chart, column 0 = 0
