@@ -267,18 +267,14 @@ void LieGroupGalerkinDiscreteLagrangian::dexp_with_derivatives(const double* q0,
       for (int l = 0; l < n; ++l)
         for (int j = 0; j < n; ++j) dexp_derivative_[l](k, j) = -velocity_hessian_[(k * V + l) * V + n + j];
   }
-  // dexp^{-T} by LU (not inverse(): at dynamic size it allocates a temporary); a fixed-size LU
-  // lives on the stack.
-  const auto invert = [&](auto& lu) {
-    lu.compute(dexp);
-    inverse_T.noalias() = lu.solve(Eigen::Map<const Matrix<N, N>>(identity_.data(), n, n));
-    inverse_T.transposeInPlace();
-  };
+  // dexp^{-T}: at a fixed size by inverse() (cofactors up to 4 x 4, else an LU on the stack); at
+  // dynamic size by the member LU (inverse() would allocate a temporary).
   if constexpr (N == Eigen::Dynamic) {
-    invert(dexp_lu_);
+    dexp_lu_.compute(dexp);
+    inverse_T.noalias() = dexp_lu_.solve(identity_);
+    inverse_T.transposeInPlace();
   } else {
-    Eigen::PartialPivLU<Matrix<N, N>> lu;
-    invert(lu);
+    inverse_T.noalias() = dexp.inverse().transpose();
   }
 }
 
