@@ -26,7 +26,8 @@
 // These are the step's equations above with tau = 0 and L(g0 exp(xi), Omega) = L(g0, Omega), so
 // the map takes the reduced form's evaluation for every such Lagrangian: the position jets would
 // add exact zeros, and took a third of a step (issue #19). `reduced` asks for it and throws where
-// it does not apply.
+// it does not apply. Its Jacobian needs only d2l/dOmega2, which is M for a Lagrangian declaring a
+// constant mass matrix (L = 1/2 v^T M v - V(q)): its nodes then evaluate L's gradient only.
 #pragma once
 
 #include <Eigen/Core>
@@ -67,15 +68,25 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   // S (also kept in action_) and, in gradient_ and (with_hessian) hessian_, its derivatives in (eta, xi^1, ..., xi^s)
   // (blocks of n numbers; block 0 is eta) for the control points in xi_ and the base point q0.
   double action(const double* q0, double h, bool with_hessian = true);
+  // The kernels below are templates on the group's dimension N and point size M, fixed for the
+  // groups listed in choose_kernels() (SO(3), SE(3)) and Eigen::Dynamic for any other: one piece
+  // of code, instantiated once per size and chosen once, at construction.
+  void choose_kernels();
   // Adds quadrature node i: L at the chart curve and the chain rule through the chart's jets.
+  template <int N, int M>
   double add_node(const double* q0, int i, double h, bool with_hessian);
   // dexp_{sign w} (= d velocity / d xi_dot at xi = -sign w) into dexp_, its inverse transpose,
   // and (with_derivatives) its derivatives in (sign w)_l (one n x n matrix each), from the
   // manifold's chart at jets.
+  template <int N>
   void dexp_with_derivatives(const double* q0, const double* w, double sign, bool with_derivatives);
   // The residual of the step's equations [p0 + D1 L_d; dS/dxi^1..s-1] (evaluate: internal only)
   // and its Jacobian in the unknowns.
+  template <int N>
   void step_equations(const double* p0, bool with_jacobian = true);
+  double (LieGroupGalerkinDiscreteLagrangian::*add_node_)(const double*, int, double, bool) = nullptr;
+  void (LieGroupGalerkinDiscreteLagrangian::*dexp_with_derivatives_)(const double*, const double*, double, bool) = nullptr;
+  void (LieGroupGalerkinDiscreteLagrangian::*step_equations_)(const double*, bool) = nullptr;
   struct Equations;  // those equations as a NewtonSolver system
   // simplified: Newton's method with the Jacobian at the first iterate (Equations), falling back
   // to the exact Jacobian when that does not contract.
@@ -101,6 +112,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   NewtonSolver solver_;
   SolverStatistics statistics_;
   bool reduced_;
+  bool constant_mass_ = false;  // reduced, and L = 1/2 v^T M v - V(q) declared: hess_'s velocity block is M
   int m_, n_, s_;
   // Workspace, sized once: a step allocates nothing.
   Eigen::MatrixXd xi_;        // n x (s+1) control points in the chart, column 0 = 0

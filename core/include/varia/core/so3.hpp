@@ -13,6 +13,7 @@
 #include <Eigen/Core>
 #include <Eigen/LU>
 #include <cmath>
+#include <concepts>
 #include <type_traits>
 
 #include "varia/core/jet.hpp"
@@ -59,11 +60,19 @@ T series(const T& x, const double (&c)[N]) {
   return sum;
 }
 
+// A second-order jet type (Jet2, FixedJet<N>): value, gradient and Hessian as members.
+template <class J>
+concept SecondOrderJet = requires(const J& x) {
+  { x.value } -> std::convertible_to<double>;
+  x.gradient;
+  x.hessian;
+};
+
 // The same series of a jet: one chain-rule step (jet::unary) with the value and the first two
 // derivatives of the polynomial summed in double at x's value (Horner's rule for p, p', p''),
 // instead of 2(N-1) jet operations with their Hessians.
-template <std::size_t N>
-Jet2 series(const Jet2& x, const double (&c)[N]) {
+template <SecondOrderJet J, std::size_t N>
+J series(const J& x, const double (&c)[N]) {
   double p = c[N - 1], d1 = 0.0, d2 = 0.0;
   for (std::size_t k = N - 1; k-- > 0;) {
     d2 = d2 * x.value + 2.0 * d1;
@@ -240,13 +249,14 @@ struct MatrixJet3 {
 };
 
 // The value and first two derivatives of a coefficient function c(x) of x = theta^2, from c at a
-// jet in the one variable x.
+// jet in the one variable x (FixedJet<1>: two numbers of derivatives, nothing to copy beyond them).
 struct Coefficient {
   double value, d1, d2;
   template <class F>
   static Coefficient at(double x, F&& c) {
-    const Jet2 y = c(Jet2::variable(x, 1, 0));
-    if (y.constant()) return {y.value, 0.0, 0.0};
+    FixedJet<1> variable(x);
+    variable.gradient(0) = 1.0;
+    const FixedJet<1> y = c(variable);
     return {y.value, y.gradient(0), y.hessian(0, 0)};
   }
 };
@@ -269,7 +279,9 @@ MatrixJet3 quadratic_in_hat(const Vector3<double>& w, A&& a_of, B&& b_of, bool s
   double al[3], bl[3];
   for (int l = 0; l < 3; ++l) {
     H[l] = hat(Vector3<double>(Vector3<double>::Unit(l)));
-    S[l] = w * Vector3<double>::Unit(l).transpose() + Vector3<double>::Unit(l) * w.transpose();
+    S[l].setZero();  // w e_l^T + e_l w^T - 2 w_l I, entry by entry (not as outer products of unit vectors)
+    S[l].col(l) += w;
+    S[l].row(l) += w.transpose();
     S[l].diagonal().array() -= 2.0 * w(l);
     al[l] = 2.0 * a.d1 * w(l);
     bl[l] = 2.0 * b.d1 * w(l);
@@ -291,11 +303,10 @@ MatrixJet3 quadratic_in_hat(const Vector3<double>& w, A&& a_of, B&& b_of, bool s
   return M;
 }
 
-// A jet in 6 variables with its value only; the caller fills gradient and Hessian.
-inline Jet2 jet6(double value) {
-  Jet2 jet(value);
-  jet.gradient.resize(6);
-  jet.hessian.resize(6, 6);
+// `jet` set to a value in 6 variables, in place; the caller fills gradient and Hessian.
+inline Jet2& jet6(Jet2& jet, double value) {
+  jet.value = value;
+  jet.resize(6);
   return jet;
 }
 
@@ -316,7 +327,7 @@ inline void chart_jets(const double* R0, const double* xi, const double* xi_dot,
   const Vector3<double> w(xi[0], xi[1], xi[2]);
   if (point != nullptr) {
     const MatrixJet3 E = quadratic_in_hat(
-        w, [](const Jet2& x) { return sinc(x); }, [](const Jet2& x) { return cosc(x); }, point_second);
+        w, [](const auto& x) { return sinc(x); }, [](const auto& x) { return cosc(x); }, point_second);
     const Matrix3<double> B = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(R0);
     const Matrix3<double> R = B * E.value;
     Matrix3<double> BH[3];  // B H_k, H_k = hat(e_k)
@@ -336,7 +347,7 @@ inline void chart_jets(const double* R0, const double* xi, const double* xi_dot,
     }
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) {
-        Jet2& jet = point[3 * r + c] = jet6(R(r, c));
+        Jet2& jet = jet6(point[3 * r + c], R(r, c));
         for (int a = 0; a < 6; ++a) {
           jet.gradient(a) = by[a](r, c);
           for (int b = 0; point_second && b < 6; ++b) jet.hessian(a, b) = by2[a][b](r, c);
@@ -346,11 +357,11 @@ inline void chart_jets(const double* R0, const double* xi, const double* xi_dot,
   if (velocity != nullptr) {
     // dexp_{-xi} = I - cosc hat(xi) + sinc3 hat(xi)^2.
     const MatrixJet3 D = quadratic_in_hat(
-        w, [](const Jet2& x) { return -cosc(x); }, [](const Jet2& x) { return sinc3(x); }, velocity_second);
+        w, [](const auto& x) { return -cosc(x); }, [](const auto& x) { return sinc3(x); }, velocity_second);
     const Eigen::Map<const Vector3<double>> rate(xi_dot);
     const Vector3<double> omega = D.value * rate;
     for (int i = 0; i < 3; ++i) {
-      Jet2& jet = velocity[i] = jet6(omega(i));
+      Jet2& jet = jet6(velocity[i], omega(i));
       if (velocity_second) jet.hessian.setZero();
       for (int k = 0; k < 3; ++k) {
         jet.gradient(k) = D.d[k].row(i).dot(rate);
