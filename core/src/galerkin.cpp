@@ -51,6 +51,25 @@ auto for_dimension(int n, F f) {
   }
 }
 
+// f(N, S) with N = n and S = s as compile-time constants for n <= 4 and s <= 6 (the simplified
+// Newton's loops then have fixed lengths and unroll), Eigen::Dynamic otherwise.
+template <class F>
+auto for_shape(int n, int s, F f) {
+  return for_dimension(n, [&](auto N) {
+    using Dynamic = std::integral_constant<int, Eigen::Dynamic>;
+    if constexpr (decltype(N)::value == Eigen::Dynamic) return f(N, Dynamic{});
+    else switch (s) {
+      case 1: return f(N, std::integral_constant<int, 1>{});
+      case 2: return f(N, std::integral_constant<int, 2>{});
+      case 3: return f(N, std::integral_constant<int, 3>{});
+      case 4: return f(N, std::integral_constant<int, 4>{});
+      case 5: return f(N, std::integral_constant<int, 5>{});
+      case 6: return f(N, std::integral_constant<int, 6>{});
+      default: return f(N, Dynamic{});
+    }
+  });
+}
+
 }  // namespace
 
 std::vector<double> equispaced_control_times(int degree) {
@@ -132,9 +151,9 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   action_ = for_dimension(n_, [](auto N) -> ActionFunction { return &GalerkinDiscreteLagrangian::action_for<decltype(N)::value>; });
   explicit_advance_ = explicit_form(quadrature);
   if (explicit_advance_ == nullptr && simplified_applies())
-    for_dimension(n_, [this](auto N) {
-      simplified_solve_ = &GalerkinDiscreteLagrangian::solve_simplified<decltype(N)::value>;
-      predict_ = &GalerkinDiscreteLagrangian::predict<decltype(N)::value>;
+    for_shape(n_, s_, [this](auto N, auto S) {
+      simplified_solve_ = &GalerkinDiscreteLagrangian::solve_simplified<decltype(N)::value, decltype(S)::value>;
+      predict_ = &GalerkinDiscreteLagrangian::predict<decltype(N)::value, decltype(S)::value>;
     });
 }
 
@@ -367,7 +386,7 @@ void GalerkinDiscreteLagrangian::take_steps(double* q, double* p, double t0, dou
 // stored once: summed in q's and v's memory, each addition waited for the store before it (at
 // s = 6 the stores were half of the action's time). Inlined into both callers (a call added 12%
 // to the s = 2 Gauss step).
-template <int N>
+template <int N, int S>
 [[gnu::always_inline]] inline void GalerkinDiscreteLagrangian::interpolate(int i, double h, double* __restrict q,
                                                                             double* __restrict v) {
   const int n = N == Eigen::Dynamic ? n_ : N;
@@ -381,7 +400,7 @@ template <int N>
     qs[r] = 0.0;
     vs[r] = 0.0;
   }
-  for (int nu = 0; nu <= s_; ++nu)
+  for (int nu = 0; nu <= (S == Eigen::Dynamic ? s_ : S); ++nu)
     for (int r = 0; r < n; ++r) {
       qs[r] += a[nu] * points[nu * n + r];
       vs[r] += da[nu] * points[nu * n + r];
@@ -568,9 +587,9 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
 // dS/dq^0 is kept in gradient_'s first block for finish(). The nodes' forces are kept in
 // node_forces_ for the next step's warm start, impulse_ as in action(). Returns F's round-off
 // yardstick, as Equations::evaluate.
-template <int N>
+template <int N, int S>
 double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p0, double* __restrict F) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = s_, r = static_cast<int>(weights_.size());
+  const int n = N == Eigen::Dynamic ? n_ : N, s = S == Eigen::Dynamic ? s_ : S, r = static_cast<int>(weights_.size());
   double* __restrict z = node_points_.data();  // (q_i, v_i) of the nodes of nonzero weight, then
   double* __restrict gradients = node_gradients_.data();  // their [L_q, L_v]
   double* __restrict last = gradient_.data() + s * n;
@@ -578,7 +597,7 @@ double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p
   double* __restrict forces = node_forces_.data();
   int count = 0;
   for (int i = 0; i < r; ++i)
-    if (weights_[i] != 0.0) interpolate<N>(i, h, z + 2 * n * count, z + 2 * n * count + n), ++count;
+    if (weights_[i] != 0.0) interpolate<N, S>(i, h, z + 2 * n * count, z + 2 * n * count + n), ++count;
   lagrangian_.gradients(count, z, gradients);
   for (int k = 0; k < s * n; ++k) F[k] = 0.0;
   for (int c = 0; c < n; ++c) last[c] = impulse[c] = 0.0;
@@ -605,9 +624,9 @@ double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p
 }
 
 // update^mu = h M^{-1} sum_nu (K^{-1})_{mu nu} F^nu (update and F: s n).
-template <int N>
+template <int N, int S>
 void GalerkinDiscreteLagrangian::simplified_update(double h, const double* F, double* update) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = s_;
+  const int n = N == Eigen::Dynamic ? n_ : N, s = S == Eigen::Dynamic ? s_ : S;
   const double* __restrict K_inverse = stiffness_inverse_.data();
   const double* __restrict M_inverse = inverse_mass_.data();
   double* __restrict combined = kinetic_.data();
@@ -627,7 +646,7 @@ void GalerkinDiscreteLagrangian::simplified_update(double h, const double* F, do
 // inverse, finish() takes the impulse less the equations' residuals at the updated points (see
 // take_step), their kinetic part brought up to date by the last update (exactly: it is linear;
 // the forces' part of the change is the residual the stopping rule leaves, below F's rounding).
-template <int N>
+template <int N, int S>
 struct GalerkinDiscreteLagrangian::Simplified {
   GalerkinDiscreteLagrangian& g;
   double h;
@@ -638,12 +657,12 @@ struct GalerkinDiscreteLagrangian::Simplified {
   bool simplified() const { return true; }
   double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
     residual = F.data();
-    return g.simplified_residual<N>(h, p0, F.data());
+    return g.simplified_residual<N, S>(h, p0, F.data());
   }
   void factorize() {}  // K^{-1} and M^{-1} are formed when the map is built
-  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { g.simplified_update<N>(h, F.data(), update.data()); }
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { g.simplified_update<N, S>(h, F.data(), update.data()); }
   double apply(const Eigen::VectorXd& update) {
-    const int n = N == Eigen::Dynamic ? g.n_ : N, size = g.s_ * n;
+    const int n = N == Eigen::Dynamic ? g.n_ : N, size = (S == Eigen::Dynamic ? g.s_ : S) * n;
     double* __restrict points = g.points_.data() + n;
     double largest = 0.0, origin = 0.0;
     for (int k = 0; k < size; ++k) {
@@ -656,7 +675,7 @@ struct GalerkinDiscreteLagrangian::Simplified {
   // impulse_ -= (dS/dq^0 + p0) + sum_{0 < nu < s} dS/dq^nu at the updated points, dS/dq^nu less
   // (1/h) M sum_mu K_numu update^mu (dS/dq^0 from gradient_, the others from F).
   void finish(const Eigen::VectorXd& update) {
-    const int n = N == Eigen::Dynamic ? g.n_ : N, s = g.s_;
+    const int n = N == Eigen::Dynamic ? g.n_ : N, s = S == Eigen::Dynamic ? g.s_ : S;
     const double* __restrict K = g.stiffness_.data();
     const double* __restrict M = g.mass_matrix_.data();
     double* __restrict kinetic = g.kinetic_.data();
@@ -677,9 +696,9 @@ struct GalerkinDiscreteLagrangian::Simplified {
   }
 };
 
-template <int N>
+template <int N, int S>
 bool GalerkinDiscreteLagrangian::solve_simplified(double h, const double* p0) {
-  Simplified<N> equations{*this, h, p0};
+  Simplified<N, S> equations{*this, h, p0};
   return solver_.solve(equations, statistics_).converged();
 }
 
@@ -690,9 +709,9 @@ bool GalerkinDiscreteLagrangian::solve_simplified(double h, const double* p0) {
 // are as smooth as the motion: the extrapolated forces are off by O(h^r) (r nodes), the control
 // points by O(h^(r+2)) (the kinetic part's inverse is O(h), times h), against O(h^(s+1)) for the
 // last step's interpolant continued (which Newton's method with the exact Jacobian starts from).
-template <int N>
+template <int N, int S>
 void GalerkinDiscreteLagrangian::predict(const double* p0, double h) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = s_, r = static_cast<int>(weights_.size());
+  const int n = N == Eigen::Dynamic ? n_ : N, s = S == Eigen::Dynamic ? s_ : S, r = static_cast<int>(weights_.size());
   const double* __restrict forces = previous_forces_.data();
   const double* __restrict weights = force_prediction_.data();
   double* __restrict equations = predicted_.data();
@@ -702,7 +721,7 @@ void GalerkinDiscreteLagrangian::predict(const double* p0, double h) {
       for (int i = 0; i < r; ++i) sum += weights[i + nu * r] * forces[i * n + c];
       equations[nu * n + c] = h * sum + (nu == 0 ? p0[c] : 0.0);
     }
-  simplified_update<N>(h, equations, change_.data());
+  simplified_update<N, S>(h, equations, change_.data());
   for (int k = 0; k < s * n; ++k) points_.data()[n + k] = -change_[k];
 }
 

@@ -97,7 +97,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   double action_for(double h, Order order, bool forced);
   using ActionFunction = double (GalerkinDiscreteLagrangian::*)(double, Order, bool);
   // The interpolant at quadrature node i into q and v.
-  template <int N>
+  template <int N, int S = Eigen::Dynamic>
   void interpolate(int i, double h, double* q, double* v);
   void add_forces(int i, double h, Order order);
   // The gradient's terms of node i with weight b and dL = [L_q; L_v] there, for the control
@@ -122,15 +122,16 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // the solve (true when it converged), and the warm start predicted from the last step's forces.
   // Compiled for N = n <= 4 and Dynamic, chosen once (simplified_solve_, predict_).
   bool simplified_applies();
-  template <int N>
+  // N = n and S = s where both are small (loops of a fixed length), else Eigen::Dynamic.
+  template <int N, int S>
   struct Simplified;  // those equations as a NewtonSolver system
-  template <int N>
+  template <int N, int S>
   double simplified_residual(double h, const double* p0, double* F);
-  template <int N>
+  template <int N, int S>
   void simplified_update(double h, const double* F, double* update);
-  template <int N>
+  template <int N, int S>
   bool solve_simplified(double h, const double* p0);
-  template <int N>
+  template <int N, int S>
   void predict(const double* p0, double h);
   using SimplifiedFunction = bool (GalerkinDiscreteLagrangian::*)(double, const double*);
   using PredictFunction = void (GalerkinDiscreteLagrangian::*)(const double*, double);
