@@ -8,6 +8,7 @@
 #include <utility>
 
 #include "core/fixtures.hpp"
+#include "core/wall.hpp"
 
 using namespace varia;
 using namespace varia::testing;
@@ -187,27 +188,12 @@ struct EvaluateOnly : Lagrangian {
   Lagrangian& inner;
 };
 
-// L = v^2/2 - sqrt(2 - q): pushed towards q = 2, where dL/dq = 1 / (2 sqrt(2 - q)) stops being
-// finite (NaN past it).
-struct Wall : sdk::AutodiffLagrangian<Wall> {
-  Wall() : sdk::AutodiffLagrangian<Wall>(1, 1) {}
-  template <class T>
-  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
-    using std::sqrt;
-    return 0.5 * v(0) * v(0) - sqrt(2.0 - q(0));
-  }
-  bool constant_mass_matrix(double* mass) const noexcept override {
-    mass[0] = 1.0;
-    return true;
-  }
-};
-
 }  // namespace
 
 // The explicit form's steps run inside the plugin (the SDK's verlet_steps: one plugin call for all
 // of them) are those of the loop that calls the plugin once a step, to the bit, at the fixed sizes
 // and the dynamic one, with the same gradient count; and where a gradient within them is not
-// finite, advance() fails as that loop does, with the same message.
+// finite (the wall at q = 1), advance() fails as that loop does, with the same message.
 TEST_CASE("galerkin explicit form run inside the plugin: the steps of one plugin call a step, bit for bit") {
   auto rule = trapezoid();
   for (int n : {1, 3, 5}) {

@@ -7,6 +7,7 @@
 
 #include "damped_drive.hpp"
 #include "fixtures.hpp"
+#include "wall.hpp"
 #include "varia/core/galerkin.hpp"
 
 namespace {
@@ -68,21 +69,6 @@ TEST_CASE("steps one by one and advance in one stretch take the same steps, to t
   CHECK(stepped.q() == advanced.q());
   CHECK(stepped.p() == advanced.p());
 }
-
-// A particle drawn into a wall at q = 1, beyond which its potential sqrt(1 - q) is not defined:
-// the explicit Stormer-Verlet form's gradient is NaN there, a NumericalFailure at that step.
-struct Wall : sdk::AutodiffLagrangian<Wall> {
-  Wall() : sdk::AutodiffLagrangian<Wall>(1, 1) {}
-  template <class T>
-  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
-    using std::sqrt;
-    return 0.5 * v(0) * v(0) - sqrt(1.0 - q(0));
-  }
-  bool constant_mass_matrix(double* mass) const noexcept override {
-    mass[0] = 1.0;
-    return true;
-  }
-};
 
 TEST_CASE("a stretch that fails is stepped again one step at a time: the failure names its step, the state is "
           "the last good one") {
