@@ -51,6 +51,12 @@ auto for_dimension(int n, F f) {
   }
 }
 
+// A size fixed at compile time, or the run-time one where it is Eigen::Dynamic.
+template <int Fixed>
+constexpr int fixed_or(int runtime) {
+  return Fixed == Eigen::Dynamic ? runtime : Fixed;
+}
+
 // f(N, S) with N = n and S = s as compile-time constants for n <= 4 and s <= 6 (the simplified
 // Newton's loops then have fixed lengths and unroll), Eigen::Dynamic otherwise.
 template <class F>
@@ -284,10 +290,17 @@ void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h
   auto run = [&](const auto& M, const auto& K, auto& qk, auto& pk, auto& f, auto& dk, auto& at, double* v,
                  double* gradient) {
     const Eigen::Map<const Vector> dLdq(gradient, n_);  // the head of [dL/dq, dL/dv]
-    Eigen::Map<Vector> q0(verlet_start_.data(), n_), d0(verlet_start_.data() + n_, n_), f0(verlet_start_.data() + 2 * n_, n_);
-    q0 = qk, d0 = dk, f0 = f;
-    if (!plugin_runs_steps_ || !lagrangian_.verlet_steps(qk.data(), dk.data(), f.data(), K.data(), steps)) {
+    // The plugin's steps; where a result is not finite, (q, h v, dL/dq) as they were for the retake.
+    const auto in_plugin = [&] {
+      if (!plugin_runs_steps_) return false;
+      Eigen::Map<Vector> q0(verlet_start_.data(), n_), d0(verlet_start_.data() + n_, n_),
+          f0(verlet_start_.data() + 2 * n_, n_);
+      q0 = qk, d0 = dk, f0 = f;
+      if (lagrangian_.verlet_steps(qk.data(), dk.data(), f.data(), K.data(), steps)) return true;
       qk = q0, dk = d0, f = f0;
+      return false;
+    };
+    if (!in_plugin()) {
       stormer_verlet_steps(qk, dk, f, K, steps, [&](const auto& x, auto& g) {
         at = x;
         lagrangian_.gradient(at.data(), v, gradient);
@@ -400,7 +413,7 @@ template <int N, int S>
     qs[r] = 0.0;
     vs[r] = 0.0;
   }
-  for (int nu = 0; nu <= (S == Eigen::Dynamic ? s_ : S); ++nu)
+  for (int nu = 0; nu <= fixed_or<S>(s_); ++nu)
     for (int r = 0; r < n; ++r) {
       qs[r] += a[nu] * points[nu * n + r];
       vs[r] += da[nu] * points[nu * n + r];
@@ -589,7 +602,7 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
 // yardstick, as Equations::evaluate.
 template <int N, int S>
 double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p0, double* __restrict F) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = S == Eigen::Dynamic ? s_ : S, r = static_cast<int>(weights_.size());
+  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_), r = static_cast<int>(weights_.size());
   double* __restrict z = node_points_.data();  // (q_i, v_i) of the nodes of nonzero weight, then
   double* __restrict gradients = node_gradients_.data();  // their [L_q, L_v]
   double* __restrict last = gradient_.data() + s * n;
@@ -626,7 +639,7 @@ double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p
 // update^mu = h M^{-1} sum_nu (K^{-1})_{mu nu} F^nu (update and F: s n).
 template <int N, int S>
 void GalerkinDiscreteLagrangian::simplified_update(double h, const double* F, double* update) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = S == Eigen::Dynamic ? s_ : S;
+  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_);
   const double* __restrict K_inverse = stiffness_inverse_.data();
   const double* __restrict M_inverse = inverse_mass_.data();
   double* __restrict combined = kinetic_.data();
@@ -662,7 +675,7 @@ struct GalerkinDiscreteLagrangian::Simplified {
   void factorize() {}  // K^{-1} and M^{-1} are formed when the map is built
   void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { g.simplified_update<N, S>(h, F.data(), update.data()); }
   double apply(const Eigen::VectorXd& update) {
-    const int n = N == Eigen::Dynamic ? g.n_ : N, size = (S == Eigen::Dynamic ? g.s_ : S) * n;
+    const int n = N == Eigen::Dynamic ? g.n_ : N, size = fixed_or<S>(g.s_) * n;
     double* __restrict points = g.points_.data() + n;
     double largest = 0.0, origin = 0.0;
     for (int k = 0; k < size; ++k) {
@@ -675,7 +688,7 @@ struct GalerkinDiscreteLagrangian::Simplified {
   // impulse_ -= (dS/dq^0 + p0) + sum_{0 < nu < s} dS/dq^nu at the updated points, dS/dq^nu less
   // (1/h) M sum_mu K_numu update^mu (dS/dq^0 from gradient_, the others from F).
   void finish(const Eigen::VectorXd& update) {
-    const int n = N == Eigen::Dynamic ? g.n_ : N, s = S == Eigen::Dynamic ? g.s_ : S;
+    const int n = N == Eigen::Dynamic ? g.n_ : N, s = fixed_or<S>(g.s_);
     const double* __restrict K = g.stiffness_.data();
     const double* __restrict M = g.mass_matrix_.data();
     double* __restrict kinetic = g.kinetic_.data();
@@ -711,7 +724,7 @@ bool GalerkinDiscreteLagrangian::solve_simplified(double h, const double* p0) {
 // last step's interpolant continued (which Newton's method with the exact Jacobian starts from).
 template <int N, int S>
 void GalerkinDiscreteLagrangian::predict(const double* p0, double h) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = S == Eigen::Dynamic ? s_ : S, r = static_cast<int>(weights_.size());
+  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_), r = static_cast<int>(weights_.size());
   const double* __restrict forces = previous_forces_.data();
   const double* __restrict weights = force_prediction_.data();
   double* __restrict equations = predicted_.data();
