@@ -208,6 +208,21 @@ GalerkinDiscreteLagrangian::AdvanceFunction GalerkinDiscreteLagrangian::explicit
 // A constant mass matrix, no forces (f(v) would add to the kinetic part), a dense Jacobian; M
 // symmetric positive definite (the Lagrangian hyperregular), and the stiffness matrix's block for
 // the step's equations invertible (it is: K's kernel is the constants, and its rows sum to 0).
+// E(m, j) = l_m(c_j): the Lagrange basis through the times t_m that are not NaN, at this step's
+// nodes (a zero row for a NaN time).
+Eigen::MatrixXd GalerkinDiscreteLagrangian::extrapolation_to_nodes(const std::vector<double>& times) const {
+  const int count = static_cast<int>(times.size()), r = static_cast<int>(nodes_.size());
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(count, r);
+  for (int m = 0; m < count; ++m)
+    for (int j = 0; j < r && !std::isnan(times[m]); ++j) {
+      double l = 1.0;
+      for (int k = 0; k < count; ++k)
+        if (k != m && !std::isnan(times[k])) l *= (nodes_[j] - times[k]) / (times[m] - times[k]);
+      E(m, j) = l;
+    }
+  return E;
+}
+
 bool GalerkinDiscreteLagrangian::simplified_applies() {
   if (!forces_.empty() || lagrangian_.sparse()) return false;
   mass_matrix_.resize(n_, n_);
@@ -223,22 +238,24 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
   stiffness_inverse_ = block.inverse();
   const int r = static_cast<int>(nodes_.size());
   node_forces_ = Eigen::MatrixXd::Zero(n_, r);
-  previous_forces_ = node_forces_;
+  force_history_ = Eigen::MatrixXd::Zero(n_, 2 * r);
   predicted_.resize(s_ * n_);
   kinetic_.resize((s_ + 1) * n_);
   node_points_.resize(2 * n_ * r);
   node_gradients_.resize(2 * n_ * r);
-  Eigen::MatrixXd extrapolation = Eigen::MatrixXd::Zero(r, r), weights(r, s_);
-  for (int i = 0; i < r; ++i) {
-    weights.row(i) = weights_[i] * basis_.phi.col(i).head(s_).transpose();
-    for (int j = 0; j < r && weights_[i] != 0.0; ++j) {
-      double l = 1.0;
-      for (int m = 0; m < r; ++m)
-        if (m != i && weights_[m] != 0.0) l *= (1.0 + nodes_[j] - nodes_[m]) / (nodes_[i] - nodes_[m]);
-      extrapolation(i, j) = l;
-    }
+  // The history's times, in steps from the next step's start: the last step's nodes c_i - 1, the
+  // step's before c_i - 2 (nodes of nonzero weight only; NaN: not used).
+  std::vector<double> last(2 * r, NAN), two_back(2 * r, NAN);
+  for (int i = 0; i < r; ++i)
+    if (weights_[i] != 0.0) last[i] = two_back[i] = nodes_[i] - 1.0;
+  for (int i = r - 1, taken = 0; i >= 0 && taken < 2; --i) {
+    const bool repeated = std::any_of(last.begin(), last.end(), [&](double t) { return std::abs(t - (nodes_[i] - 2.0)) < 1e-12; });
+    if (weights_[i] != 0.0 && !repeated) two_back[r + i] = nodes_[i] - 2.0, ++taken;
   }
-  force_prediction_ = extrapolation * weights;
+  Eigen::MatrixXd weights(r, s_);
+  for (int j = 0; j < r; ++j) weights.row(j) = weights_[j] * basis_.phi.col(j).head(s_).transpose();
+  force_prediction_[0] = extrapolation_to_nodes(last) * weights;
+  force_prediction_[1] = extrapolation_to_nodes(two_back) * weights;
   return true;
 }
 
@@ -716,22 +733,24 @@ bool GalerkinDiscreteLagrangian::solve_simplified(double h, const double* p0) {
 }
 
 // The warm start: the step's equations are linear in the control points once the forces g_i are
-// given. With the last step's forces continued as the polynomial through its nodes,
-// g_j ~ sum_i l_i(1 + c_j) g_i^prev (force_prediction_ holds those weights times b_j l_nu(c_j)),
-// they are solved for the control points by the simplified Jacobian. The forces along the motion
-// are as smooth as the motion: the extrapolated forces are off by O(h^r) (r nodes), the control
-// points by O(h^(r+2)) (the kinetic part's inverse is O(h), times h), against O(h^(s+1)) for the
-// last step's interpolant continued (which Newton's method with the exact Jacobian starts from).
+// given. With the forces of the last steps continued as the polynomial through their nodes,
+// g_j ~ sum_m l_m(c_j) g_m (force_prediction_ holds those weights times b_j l_nu(c_j)), they are
+// solved for the control points by the simplified Jacobian. The forces along the motion are as
+// smooth as the motion: through the last step's r nodes the extrapolated forces are off by O(h^r),
+// the control points by O(h^(r+2)) (the kinetic part's inverse is O(h), times h); with two more
+// nodes of the step before (as Hairer's gni_irk2 starts from s + 2 forces), by O(h^(r+2)) and
+// O(h^(r+4)). Against O(h^(s+1)) for the last step's interpolant continued (which Newton's method
+// with the exact Jacobian starts from).
 template <int N, int S>
 void GalerkinDiscreteLagrangian::predict(const double* p0, double h) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_), r = static_cast<int>(weights_.size());
-  const double* __restrict forces = previous_forces_.data();
-  const double* __restrict weights = force_prediction_.data();
+  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_), count = static_cast<int>(force_history_.cols());
+  const double* __restrict forces = force_history_.data();
+  const double* __restrict weights = force_prediction_[two_steps_back_ ? 1 : 0].data();
   double* __restrict equations = predicted_.data();
   for (int nu = 0; nu < s; ++nu)
     for (int c = 0; c < n; ++c) {
       double sum = 0.0;
-      for (int i = 0; i < r; ++i) sum += weights[i + nu * r] * forces[i * n + c];
+      for (int m = 0; m < count; ++m) sum += weights[m + nu * count] * forces[m * n + c];
       equations[nu * n + c] = h * sum + (nu == 0 ? p0[c] : 0.0);
     }
   simplified_update<N, S>(h, equations, change_.data());
@@ -869,6 +888,7 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
     carry_p_.setZero();
   }
   t_ = t0;
+  const bool continues = has_previous_ && previous_h_ == h && previous_end_ == start;
   warm_start(q0, p0, h);
   newton(h, 1, 0, s_, p0, !forces_.empty());  // impulse_ is then p1 - p0 (the solvers' finish())
   Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);
@@ -878,9 +898,12 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   compensated_add(end_p_, impulse_, carry_p_);
   end = previous_end_;
   momentum1 = end_p_;
-  if (predict_ != nullptr)
-    previous_forces_.swap(node_forces_);  // node_forces_ is written again before it is read
-  else
+  if (predict_ != nullptr) {  // the history shifts by a step
+    const Eigen::Index r = node_forces_.cols();
+    force_history_.rightCols(r) = force_history_.leftCols(r);
+    force_history_.leftCols(r) = node_forces_;
+    two_steps_back_ = continues;
+  } else
     previous_ = points_;
   previous_h_ = h;
   has_previous_ = true;

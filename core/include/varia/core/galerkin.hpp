@@ -122,6 +122,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // the solve (true when it converged), and the warm start predicted from the last step's forces.
   // Compiled for N = n <= 4 and Dynamic, chosen once (simplified_solve_, predict_).
   bool simplified_applies();
+  Eigen::MatrixXd extrapolation_to_nodes(const std::vector<double>& times) const;
   // N = n and S = s where both are small (loops of a fixed length), else Eigen::Dynamic.
   template <int N, int S>
   struct Simplified;  // those equations as a NewtonSolver system
@@ -209,15 +210,19 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   AdvanceFunction explicit_advance_ = nullptr;
   // Simplified Newton (constant mass matrix): the stiffness matrix K ((s+1) x (s+1)), the inverse
   // of its block K(0..s-1, 1..s), and M^{-1} (inverse_mass_). Its warm start (predict()): the forces dL/dq at the
-  // nodes of the last evaluation (node_forces_, n x r) and of the last step (previous_forces_),
-  // and force_prediction_ (r x s): the extrapolation of the nodes' forces to the next step's
-  // nodes (l_i(1 + c_j), the Lagrange basis through the nodes) times the weights b_j l_nu(c_j) of
-  // the step's equations. Workspace: the equations' value at the predicted forces (s n), and
-  // products of the kinetic part ((s+1) n).
+  // nodes of the last evaluation (node_forces_, n x r) and of the last two steps (force_history_,
+  // n x 2r: the last step's nodes, then the one's before), and force_prediction_[k] (2r x s):
+  // the extrapolation of those forces to the next step's nodes (the Lagrange basis through the
+  // last step's nodes, k = 0, or through those and the two latest distinct nodes of the step
+  // before, k = 1, at the next step's nodes) times the weights b_j l_nu(c_j) of the step's
+  // equations; two_steps_back_ says whether the step before the last is in the history (the last
+  // continued it with the same h). Workspace: the equations' value at the predicted forces (s n),
+  // and products of the kinetic part ((s+1) n).
   SimplifiedFunction simplified_solve_ = nullptr;
   PredictFunction predict_ = nullptr;
   Eigen::MatrixXd stiffness_, stiffness_inverse_;
-  Eigen::MatrixXd node_forces_, previous_forces_, force_prediction_;
+  Eigen::MatrixXd node_forces_, force_history_, force_prediction_[2];
+  bool two_steps_back_ = false;
   Eigen::VectorXd predicted_, kinetic_;
   Eigen::VectorXd node_points_, node_gradients_;  // the nodes' (q, v) and [L_q, L_v], 2n each
   double b0_ = 0.0, b1_ = 0.0;
