@@ -205,9 +205,6 @@ GalerkinDiscreteLagrangian::AdvanceFunction GalerkinDiscreteLagrangian::explicit
       n_, [](auto N) -> AdvanceFunction { return &GalerkinDiscreteLagrangian::explicit_advance<decltype(N)::value>; });
 }
 
-// A constant mass matrix, no forces (f(v) would add to the kinetic part), a dense Jacobian; M
-// symmetric positive definite (the Lagrangian hyperregular), and the stiffness matrix's block for
-// the step's equations invertible (it is: K's kernel is the constants, and its rows sum to 0).
 // E(m, j) = l_m(c_j): the Lagrange basis through the times t_m that are not NaN, at this step's
 // nodes (a zero row for a NaN time).
 Eigen::MatrixXd GalerkinDiscreteLagrangian::extrapolation_to_nodes(const std::vector<double>& times) const {
@@ -223,6 +220,9 @@ Eigen::MatrixXd GalerkinDiscreteLagrangian::extrapolation_to_nodes(const std::ve
   return E;
 }
 
+// A constant mass matrix, no forces (f(v) would add to the kinetic part), a dense Jacobian; M
+// symmetric positive definite (the Lagrangian hyperregular), and the stiffness matrix's block for
+// the step's equations invertible (it is: K's kernel is the constants, and its rows sum to 0).
 bool GalerkinDiscreteLagrangian::simplified_applies() {
   if (!forces_.empty() || lagrangian_.sparse()) return false;
   mass_matrix_.resize(n_, n_);
@@ -743,14 +743,15 @@ bool GalerkinDiscreteLagrangian::solve_simplified(double h, const double* p0) {
 // with the exact Jacobian starts from).
 template <int N, int S>
 void GalerkinDiscreteLagrangian::predict(const double* p0, double h) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_), count = static_cast<int>(force_history_.cols());
+  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_), stride = static_cast<int>(force_history_.cols()),
+            count = two_steps_back_ ? stride : stride / 2;  // the columns in use
   const double* __restrict forces = force_history_.data();
   const double* __restrict weights = force_prediction_[two_steps_back_ ? 1 : 0].data();
   double* __restrict equations = predicted_.data();
   for (int nu = 0; nu < s; ++nu)
     for (int c = 0; c < n; ++c) {
       double sum = 0.0;
-      for (int m = 0; m < count; ++m) sum += weights[m + nu * count] * forces[m * n + c];
+      for (int m = 0; m < count; ++m) sum += weights[m + nu * stride] * forces[m * n + c];
       equations[nu * n + c] = h * sum + (nu == 0 ? p0[c] : 0.0);
     }
   simplified_update<N, S>(h, equations, change_.data());
@@ -854,12 +855,13 @@ void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unkno
 // follows it, otherwise a straight line with the velocity of the inverse Legendre transform.
 // Offsets from q0 = the last step's q1: q(1 + d_nu) - q1 = sum_mu l_mu(1 + d_nu) (q_prev^mu -
 // q_prev^0) - (q_prev^s - q_prev^0).
-void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
+bool GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
   const Eigen::Map<const Eigen::VectorXd> start(q0, n_);
+  const bool continues = has_previous_ && previous_h_ == h && previous_end_ == start;
   origin_ = start;
-  if (has_previous_ && previous_h_ == h && previous_end_ == start && predict_ != nullptr) {
+  if (continues && predict_ != nullptr) {
     (this->*predict_)(p0, h);
-  } else if (has_previous_ && previous_h_ == h && previous_end_ == start) {
+  } else if (continues) {
     points_.noalias() = previous_ * extrapolation_;
     points_.colwise() -= previous_.col(s_);
   } else {
@@ -867,6 +869,7 @@ void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, 
     for (int nu = 0; nu <= s_; ++nu) points_.col(nu) = (basis_.control_times[nu] * h) * velocity_;
   }
   points_.col(0).setZero();
+  return continues;
 }
 
 // q1 = q0 + (q^s - q^0), and p1 = D2 L_d + f_d^s written as p0 plus its change: the equations
@@ -888,8 +891,7 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
     carry_p_.setZero();
   }
   t_ = t0;
-  const bool continues = has_previous_ && previous_h_ == h && previous_end_ == start;
-  warm_start(q0, p0, h);
+  const bool continues = warm_start(q0, p0, h);
   newton(h, 1, 0, s_, p0, !forces_.empty());  // impulse_ is then p1 - p0 (the solvers' finish())
   Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);
   previous_end_ = start;

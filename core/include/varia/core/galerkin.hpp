@@ -140,7 +140,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
   void gradient_after_update(double h, int first_unknown, const Eigen::VectorXd& update, bool forced);
-  void warm_start(const double* q0, const double* p0, double h);
+  bool warm_start(const double* q0, const double* p0, double h);  // true: the step continues the last one
   // Degree 1 with nodes only at 0 and 1 and a constant mass matrix M: the IDEL equations are
   // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton. For a dense
   // Lagrangian the steps are compiled for N = n (fixed-size arithmetic, the state in registers
