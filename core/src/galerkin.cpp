@@ -15,13 +15,15 @@ namespace varia {
 namespace {
 
 // l_nu(tau) and l'_nu(tau) of the Lagrange basis through the control times d.
-void lagrange(const std::vector<double>& d, double tau, double* l, double* dl) {
+// (In T: the node iteration's maps are formed in long double.)
+template <class T>
+void lagrange(const std::vector<double>& d, T tau, T* l, T* dl) {
   const int count = static_cast<int>(d.size());
   for (int nu = 0; nu < count; ++nu) {
-    double value = 1.0, derivative = 0.0;
+    T value = 1.0, derivative = 0.0;
     for (int mu = 0; mu < count; ++mu) {
       if (mu == nu) continue;
-      const double denominator = d[nu] - d[mu];
+      const T denominator = T(d[nu]) - T(d[mu]);
       derivative = derivative * (tau - d[mu]) / denominator + value / denominator;
       value *= (tau - d[mu]) / denominator;
     }
@@ -57,8 +59,9 @@ constexpr int fixed_or(int runtime) {
   return Fixed == Eigen::Dynamic ? runtime : Fixed;
 }
 
-// f(N, S) with N = n and S = s as compile-time constants for n <= 4 and s <= 6 (the simplified
-// Newton's loops then have fixed lengths and unroll), Eigen::Dynamic otherwise.
+// f(N, R) with N = n and R = the number of nodes as compile-time constants for n <= 4 and R <= 7
+// (s Gauss-Legendre or s + 1 Lobatto points for s <= 6: the node iteration's loops then have
+// fixed lengths and unroll), Eigen::Dynamic otherwise.
 template <class F>
 auto for_shape(int n, int s, F f) {
   return for_dimension(n, [&](auto N) {
@@ -71,6 +74,7 @@ auto for_shape(int n, int s, F f) {
       case 4: return f(N, std::integral_constant<int, 4>{});
       case 5: return f(N, std::integral_constant<int, 5>{});
       case 6: return f(N, std::integral_constant<int, 6>{});
+      case 7: return f(N, std::integral_constant<int, 7>{});
       default: return f(N, Dynamic{});
     }
   });
@@ -96,7 +100,7 @@ LagrangeBasis::LagrangeBasis(const std::vector<double>& times, const Quadrature&
 
 Eigen::VectorXd LagrangeBasis::at(double tau) const {
   Eigen::VectorXd l(control_times.size());
-  lagrange(control_times, tau, l.data(), nullptr);
+  lagrange<double>(control_times, tau, l.data(), nullptr);
   return l;
 }
 
@@ -157,9 +161,8 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   action_ = for_dimension(n_, [](auto N) -> ActionFunction { return &GalerkinDiscreteLagrangian::action_for<decltype(N)::value>; });
   explicit_advance_ = explicit_form(quadrature);
   if (explicit_advance_ == nullptr && simplified_applies())
-    for_shape(n_, s_, [this](auto N, auto S) {
-      simplified_solve_ = &GalerkinDiscreteLagrangian::solve_simplified<decltype(N)::value, decltype(S)::value>;
-      predict_ = &GalerkinDiscreteLagrangian::predict<decltype(N)::value, decltype(S)::value>;
+    node_solve_ = for_shape(n_, static_cast<int>(iteration_nodes_.size()), [](auto N, auto R) -> NodeSolveFunction {
+      return &GalerkinDiscreteLagrangian::solve_at_nodes<decltype(N)::value, decltype(R)::value>;
     });
 }
 
@@ -205,16 +208,16 @@ GalerkinDiscreteLagrangian::AdvanceFunction GalerkinDiscreteLagrangian::explicit
       n_, [](auto N) -> AdvanceFunction { return &GalerkinDiscreteLagrangian::explicit_advance<decltype(N)::value>; });
 }
 
-// E(m, j) = l_m(c_j): the Lagrange basis through the times t_m that are not NaN, at this step's
-// nodes (a zero row for a NaN time).
+// E(m, j) = l_m(c_j): the Lagrange basis through the times t_m that are not NaN, at the
+// iteration's nodes c_j (a zero row for a NaN time).
 Eigen::MatrixXd GalerkinDiscreteLagrangian::extrapolation_to_nodes(const std::vector<double>& times) const {
-  const int count = static_cast<int>(times.size()), r = static_cast<int>(nodes_.size());
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(count, r);
+  const int count = static_cast<int>(times.size()), R = static_cast<int>(iteration_nodes_.size());
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(count, R);
   for (int m = 0; m < count; ++m)
-    for (int j = 0; j < r && !std::isnan(times[m]); ++j) {
+    for (int j = 0; j < R && !std::isnan(times[m]); ++j) {
       double l = 1.0;
       for (int k = 0; k < count; ++k)
-        if (k != m && !std::isnan(times[k])) l *= (nodes_[j] - times[k]) / (times[m] - times[k]);
+        if (k != m && !std::isnan(times[k])) l *= (nodes_[iteration_nodes_[j]] - times[k]) / (times[m] - times[k]);
       E(m, j) = l;
     }
   return E;
@@ -223,6 +226,13 @@ Eigen::MatrixXd GalerkinDiscreteLagrangian::extrapolation_to_nodes(const std::ve
 // A constant mass matrix, no forces (f(v) would add to the kinetic part), a dense Jacobian; M
 // symmetric positive definite (the Lagrangian hyperregular), and the stiffness matrix's block for
 // the step's equations invertible (it is: K's kernel is the constants, and its rows sum to 0).
+// The maps (see the top of galerkin.hpp): with the forces g_j at the R nodes of nonzero weight
+// given, the step's equations
+//   p0 delta_nu0 + (1/h) M sum_{mu=1..s} K_numu X^mu + h sum_j b_j l_nu(c_j) g_j = 0, nu < s,
+// in the offsets X^mu = q^mu - q^0 are linear, solved by the inverse of K's block:
+//   X^mu = h (alpha_mu u0 + h sum_j P_muj M^{-1} g_j), alpha_mu = -(K^{-1})_{mu 0},
+//   P_muj = -b_j sum_nu (K^{-1})_{mu nu} l_nu(c_j),   u0 = M^{-1} p0,
+// and the nodes' offsets are the interpolant's there, sum_mu l_mu(c_i) X^mu.
 bool GalerkinDiscreteLagrangian::simplified_applies() {
   if (!forces_.empty() || lagrangian_.sparse()) return false;
   mass_matrix_.resize(n_, n_);
@@ -230,32 +240,64 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
   const Eigen::LLT<Eigen::MatrixXd> mass(mass_matrix_);
   if (mass.info() != Eigen::Success) return false;
   inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
-  stiffness_ = Eigen::MatrixXd::Zero(s_ + 1, s_ + 1);
-  for (int i = 0; i < basis_.dphi.cols(); ++i)
-    stiffness_.noalias() += weights_[i] * basis_.dphi.col(i) * basis_.dphi.col(i).transpose();
-  const Eigen::FullPivLU<Eigen::MatrixXd> block(stiffness_.block(0, 1, s_, s_));
-  if (!block.isInvertible()) return false;
-  stiffness_inverse_ = block.inverse();
+  // In long double (64-bit mantissa on x86, else double): K's block is ill-conditioned at larger s,
+  // and a map's rounding is a change of the method, the same at every step (formed in double, the
+  // s = 6 Gauss steps of the pendulum ended 5.0e-14 from gni_irk2's over 2000 steps, against 2.7e-15).
+  using Extended = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
   const int r = static_cast<int>(nodes_.size());
-  node_forces_ = Eigen::MatrixXd::Zero(n_, r);
-  force_history_ = Eigen::MatrixXd::Zero(n_, 2 * r);
-  predicted_.resize(s_ * n_);
-  kinetic_.resize((s_ + 1) * n_);
-  node_points_.resize(2 * n_ * r);
-  node_gradients_.resize(2 * n_ * r);
-  // The history's times, in steps from the next step's start: the last step's nodes c_i - 1, the
-  // step's before c_i - 2 (nodes of nonzero weight only; NaN: not used).
-  std::vector<double> last(2 * r, NAN), two_back(2 * r, NAN);
-  for (int i = 0; i < r; ++i)
-    if (weights_[i] != 0.0) last[i] = two_back[i] = nodes_[i] - 1.0;
-  for (int i = r - 1, taken = 0; i >= 0 && taken < 2; --i) {
-    const bool repeated = std::any_of(last.begin(), last.end(), [&](double t) { return std::abs(t - (nodes_[i] - 2.0)) < 1e-12; });
-    if (weights_[i] != 0.0 && !repeated) two_back[r + i] = nodes_[i] - 2.0, ++taken;
+  Extended phi(s_ + 1, r), dphi(s_ + 1, r), stiffness = Extended::Zero(s_ + 1, s_ + 1);
+  for (int i = 0; i < r; ++i) {
+    lagrange<long double>(basis_.control_times, nodes_[i], phi.col(i).data(), dphi.col(i).data());
+    stiffness.noalias() += static_cast<long double>(weights_[i]) * dphi.col(i) * dphi.col(i).transpose();
   }
-  Eigen::MatrixXd weights(r, s_);
-  for (int j = 0; j < r; ++j) weights.row(j) = weights_[j] * basis_.phi.col(j).head(s_).transpose();
-  force_prediction_[0] = extrapolation_to_nodes(last) * weights;
-  force_prediction_[1] = extrapolation_to_nodes(two_back) * weights;
+  const Eigen::FullPivLU<Extended> block(stiffness.block(0, 1, s_, s_));
+  if (!block.isInvertible()) return false;
+  const Extended K_inverse = block.inverse();  // row mu - 1 (X^mu), column nu (equation)
+  iteration_nodes_.clear();
+  for (int i = 0; i < r; ++i)
+    if (weights_[i] != 0.0) iteration_nodes_.push_back(i);
+  const int R = static_cast<int>(iteration_nodes_.size());
+  Extended control(s_, 1 + R), interpolation(R, s_);  // interpolation: l_mu(c_j), mu = 1..s
+  control.col(0) = -K_inverse.col(0);
+  for (int j = 0; j < R; ++j) {
+    const int i = iteration_nodes_[j];
+    control.col(1 + j) = -static_cast<long double>(weights_[i]) * K_inverse * phi.col(i).head(s_);
+    interpolation.row(j) = phi.col(i).tail(s_).transpose();
+  }
+  // The straight line X^mu = d_mu h u0 solves the equations without forces where the quadrature
+  // integrates l'_nu exactly (sum_mu K_numu d_mu = l_nu(1) - l_nu(0)): then alpha_mu = d_mu, and
+  // the nodes' coefficient of u0 is c_j. Where alpha agrees with that to rounding, the exact values
+  // are taken: through K^{-1} alpha_s is off by an ulp, the same at every step, and q1 - q0 =
+  // h alpha_s u0 + ... walked by an ulp of h u0 a step (with the maps in double, the s = 4 Gauss
+  // steps of the pendulum ended 3.5e-14 from gni_irk2's over 4000 steps without this, 3.7e-15 with
+  // it; in long double without it, the s = 6 steps parted from exact Newton's by 4e-14, 1e-14 with).
+  const Eigen::VectorXd line = Eigen::Map<const Eigen::VectorXd>(basis_.control_times.data() + 1, s_);
+  control_map_ = control.cast<double>();
+  node_map_ = (interpolation * control).cast<double>();
+  if ((control_map_.col(0) - line).lpNorm<Eigen::Infinity>() <= 1e-12) {
+    control_map_.col(0) = line;
+    for (int j = 0; j < R; ++j) node_map_(j, 0) = nodes_[iteration_nodes_[j]];
+  }
+  mass_norm_ = mass_matrix_.cwiseAbs().rowwise().sum().maxCoeff();
+  end_map_ = control_map_.bottomRows(1);
+  velocity0_.resize(n_);
+  for (Eigen::VectorXd* v : {&node_offsets_, &next_offsets_, &node_accelerations_, &predicted_forces_, &predicted_accelerations_})
+    v->resize(R * n_);
+  node_points_ = Eigen::VectorXd::Zero(2 * n_ * R);  // the velocities stay 0 (L_q does not depend on v)
+  node_gradients_.resize(2 * n_ * R);
+  node_forces_ = Eigen::MatrixXd::Zero(n_, R);
+  force_history_ = Eigen::MatrixXd::Zero(n_, 2 * R);
+  // The history's times, in steps from the next step's start: the last step's nodes c_j - 1, the
+  // step's before c_j - 2 (NaN: not used).
+  std::vector<double> last(2 * R, NAN), two_back(2 * R, NAN);
+  for (int j = 0; j < R; ++j) last[j] = two_back[j] = nodes_[iteration_nodes_[j]] - 1.0;
+  for (int j = R - 1, taken = 0; j >= 0 && taken < 2; --j) {
+    const double t = nodes_[iteration_nodes_[j]] - 2.0;
+    const bool repeated = std::any_of(last.begin(), last.end(), [&](double u) { return std::abs(u - t) < 1e-12; });
+    if (!repeated) two_back[R + j] = t, ++taken;
+  }
+  force_extrapolation_[0] = extrapolation_to_nodes(last);
+  force_extrapolation_[1] = extrapolation_to_nodes(two_back);
   return true;
 }
 
@@ -463,7 +505,7 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
   }
   if (order == Order::hessian && sparse) sparse_.matrix.coeffs().setZero();
   if (order == Order::hessian && !sparse) hessian_.setZero();
-  for (int i = 0; i < basis_.phi.cols(); ++i) {
+  for (int i = 0, j = 0; i < basis_.phi.cols(); ++i) {
     if (weights_[i] == 0.0) continue;
     interpolate<N>(i, h, q_.data(), v_.data());
     double L = 0.0;
@@ -482,8 +524,9 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
     if (order == Order::value) continue;
     for (int c = 0; c < n; ++c) {
       impulse_[c] += (h * b) * grad_[c];
-      if (predict_ != nullptr) node_forces_(c, i) = grad_[c];
+      if (node_solve_ != nullptr) node_forces_(c, j) = grad_[c];
     }
+    ++j;
     if (forced) add_forces(i, h, order);
     if (order == Order::hessian && sparse)
       add_sparse_entries(i, h, 0, sparse_values_.data(), static_cast<int>(sparse_values_.size()), h * b);
@@ -600,162 +643,165 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
   sparse_.analyzed = false;
 }
 
-// ---- simplified Newton for a constant mass matrix (galerkin.hpp) -----------------------------
-// The step's equations, nu = 0..s-1, in the offsets X^mu = q^mu - q^0 (mu = 1..s, X^0 = 0),
-//   F^nu = p0 delta_nu0 + (1/h) M sum_mu K_numu X^mu + h sum_i b_i l_nu(c_i) g_i,  g_i = dL/dq(q_i),
-// (dS/dq^nu of action() with L_v = M v summed analytically), and their kinetic part's inverse. Plain
-// loops over a handful of numbers, n fixed for n <= 4: at these sizes a dynamic-size product's
-// setup costs more than its arithmetic. K is stiffness_ ((s+1) x (s+1)), K^{-1} the inverse of its
-// block K(0..s-1, 1..s) (stiffness_inverse_), both column-major.
+// ---- simplified Newton for a constant mass matrix, in the nodes' coordinates (galerkin.hpp) --
+// Plain loops over a handful of numbers, n and R fixed where small: at these sizes a dynamic-size
+// product's setup costs more than its arithmetic.
 
-// F at the control points in points_ into F (s n): action()'s dS/dq^nu (the plugin's L_v, not
-// K M q^mu / h: K's entries are rounded once, and that rounding, the same at every step, moved the
-// solution by an ulp a step), with p0 added to the equation nu = 0, summed node by node straight
-// into F (issue #19: the step is a chain of dependent passes through memory; a pass into the
-// action's gradient and a copy of it into F made that chain two stores and loads longer). The
-// nodes are evaluated in one plugin call (Lagrangian::gradients), not one a node. dS/dq^s is summed only for the yardstick (into gradient_'s last block), and
-// dS/dq^0 is kept in gradient_'s first block for finish(). The nodes' forces are kept in
-// node_forces_ for the next step's warm start, impulse_ as in action(). Returns F's round-off
-// yardstick, as Equations::evaluate.
-template <int N, int S>
-double GalerkinDiscreteLagrangian::simplified_residual(double h, const double* p0, double* __restrict F) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_), r = static_cast<int>(weights_.size());
-  double* __restrict z = node_points_.data();  // (q_i, v_i) of the nodes of nonzero weight, then
-  double* __restrict gradients = node_gradients_.data();  // their [L_q, L_v]
-  double* __restrict last = gradient_.data() + s * n;
-  double* __restrict impulse = impulse_.data();
-  double* __restrict forces = node_forces_.data();
-  int count = 0;
-  for (int i = 0; i < r; ++i)
-    if (weights_[i] != 0.0) interpolate<N, S>(i, h, z + 2 * n * count, z + 2 * n * count + n), ++count;
-  lagrangian_.gradients(count, z, gradients);
-  for (int k = 0; k < s * n; ++k) F[k] = 0.0;
-  for (int c = 0; c < n; ++c) last[c] = impulse[c] = 0.0;
-  for (int i = 0, j = 0; i < r; ++i) {
-    const double b = weights_[i];
-    if (b == 0.0) continue;
-    const double* dL = gradients + 2 * n * j++;
+// offsets(j) = h (map(j, 0) u0 + h sum_i map(j, 1 + i) a_i) for the rows j of map, with
+// u0 = velocity0_ and a_i = M^{-1} g_i the forces' accelerations at the R nodes (n each).
+// Offsets from q0, numbers of size h |v|: q0 + offset rounds to eps |q0|, where forming the
+// positions themselves would add eps |q0| at every step (docs/hard-cases.md, Kepler).
+template <int N, int R>
+[[gnu::always_inline]] inline void GalerkinDiscreteLagrangian::offsets_from_forces(const Eigen::MatrixXd& map, double h,
+                                                                                  const double* __restrict accelerations,
+                                                                                  double* __restrict offsets) const {
+  const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size())),
+            rows = static_cast<int>(map.rows());
+  const double* __restrict W = map.data();
+  const double* __restrict u0 = velocity0_.data();
+  for (int j = 0; j < rows; ++j)
     for (int c = 0; c < n; ++c) {
-      impulse[c] += (h * b) * dL[c];
-      forces[i * n + c] = dL[c];
+      double sum = 0.0;
+      for (int i = 0; i < nodes; ++i) sum += W[j + (1 + i) * rows] * accelerations[i * n + c];
+      offsets[j * n + c] = h * (W[j] * u0[c] + h * sum);
     }
-    add_gradient<N>(i, h, b, dL, F, 0, s);
-    add_gradient<N>(i, h, b, dL, last, s, 1);
-  }
-  double yardstick = 0.0;
-  for (int k = 0; k < s * n; ++k) yardstick = std::max(yardstick, std::abs(F[k]));
-  for (int c = 0; c < n; ++c) {
-    yardstick = std::max(yardstick, std::abs(last[c]));
-    gradient_[c] = F[c];
-    F[c] += p0[c];
-    yardstick = std::max(yardstick, std::abs(p0[c]));
-  }
-  return yardstick;
 }
 
-// update^mu = h M^{-1} sum_nu (K^{-1})_{mu nu} F^nu (update and F: s n).
-template <int N, int S>
-void GalerkinDiscreteLagrangian::simplified_update(double h, const double* F, double* update) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_);
-  const double* __restrict K_inverse = stiffness_inverse_.data();
+// The fixed point's residual at the nodes' offsets D (node_offsets_): the forces g_j = dL/dq at
+// q0 + D_j in one plugin call (Lagrangian::gradients; v = 0: for this Lagrangian L_q does not
+// depend on v), kept with M^{-1} g_j, the offsets D' that the step's equations give for those
+// forces (into next_offsets_), and F = M (D - D') / h (R n). F is the equations' residual in their
+// own units, momentum (at X, with X' the control points of D', the residual of equation nu is
+// (1/h) M sum_mu K_numu (X^mu - X'^mu)): the stopping rule's tolerance means what it means for
+// the equations, and its yardstick is theirs, |p0| and the kinetic terms |M D'| / h. (The
+// offsets' difference itself is smaller by h / |M|: at tolerance (1 + yardstick) in positions the
+// rule stopped with systematic errors h^-1 times larger, and the s = 6 Gauss steps of the
+// pendulum ended 1.6e-13 from gni_irk2's instead of 2e-15.)
+template <int N, int R>
+double GalerkinDiscreteLagrangian::node_residual(double h, const double* __restrict p0, double* __restrict F) {
+  const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
+  const double* __restrict q0 = origin_.data();
+  const double* __restrict D = node_offsets_.data();
+  const double* __restrict M = mass_matrix_.data();
   const double* __restrict M_inverse = inverse_mass_.data();
-  double* __restrict combined = kinetic_.data();
-  for (int mu = 0; mu < s; ++mu) {
-    for (int c = 0; c < n; ++c) combined[c] = 0.0;
-    for (int nu = 0; nu < s; ++nu)
-      for (int c = 0; c < n; ++c) combined[c] += K_inverse[mu + nu * s] * F[nu * n + c];
+  double* __restrict z = node_points_.data();
+  double* __restrict gradients = node_gradients_.data();
+  double* __restrict forces = node_forces_.data();
+  double* __restrict accelerations = node_accelerations_.data();
+  double* __restrict next = next_offsets_.data();
+  for (int j = 0; j < nodes; ++j)
+    for (int c = 0; c < n; ++c) z[2 * n * j + c] = q0[c] + D[j * n + c];
+  lagrangian_.gradients(nodes, z, gradients);
+  for (int j = 0; j < nodes; ++j) {
+    const double* g = gradients + 2 * n * j;
     for (int c = 0; c < n; ++c) {
-      double m = 0.0;
-      for (int d = 0; d < n; ++d) m += M_inverse[c + d * n] * combined[d];
-      update[mu * n + c] = h * m;
+      forces[j * n + c] = g[c];
+      double a = 0.0;
+      for (int d = 0; d < n; ++d) a += M_inverse[c + d * n] * g[d];
+      accelerations[j * n + c] = a;
     }
   }
+  offsets_from_forces<N, R>(node_map_, h, accelerations, next);
+  double largest = 0.0, momentum = 0.0;
+  for (int j = 0; j < nodes; ++j)
+    for (int c = 0; c < n; ++c) {
+      double f = 0.0;
+      for (int d = 0; d < n; ++d) f += M[c + d * n] * (D[j * n + d] - next[j * n + d]);
+      F[j * n + c] = f / h;
+      largest = std::max(largest, std::abs(next[j * n + c]));
+    }
+  for (int c = 0; c < n; ++c) momentum = std::max(momentum, std::abs(p0[c]));
+  return std::max(momentum, mass_norm_ * largest / h);
 }
 
-// The step's equations as a NewtonSolver system with the simplified Jacobian: solve() applies its
-// inverse, finish() takes the impulse less the equations' residuals at the updated points (see
-// take_step), their kinetic part brought up to date by the last update (exactly: it is linear;
-// the forces' part of the change is the residual the stopping rule leaves, below F's rounding).
-template <int N, int S>
-struct GalerkinDiscreteLagrangian::Simplified {
+// The fixed point D = D'(g(q0 + D)) as a NewtonSolver system with the Jacobian M / h at every node
+// (the simplified Newton's of the control points, the kinetic part, carried to the nodes: the
+// same iterates): solve()'s update is h M^{-1} F = D - D', and apply() moves to D' (which is
+// D - update before rounding).
+template <int N, int R>
+struct GalerkinDiscreteLagrangian::NodeIteration {
   GalerkinDiscreteLagrangian& g;
   double h;
   const double* p0;
-  const double* residual = nullptr;  // F at the last evaluation (the solver's)
 
-  int size() const { return g.s_ * g.n_; }
+  int size() const { return static_cast<int>(g.node_offsets_.size()); }
   bool simplified() const { return true; }
-  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
-    residual = F.data();
-    return g.simplified_residual<N, S>(h, p0, F.data());
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.node_residual<N, R>(h, p0, F.data()); }
+  void factorize() {}
+  void solve(const Eigen::VectorXd&, Eigen::VectorXd& update) {
+    const int size = fixed_or<R>(static_cast<int>(g.iteration_nodes_.size())) * fixed_or<N>(g.n_);
+    for (int k = 0; k < size; ++k) update[k] = g.node_offsets_[k] - g.next_offsets_[k];
   }
-  void factorize() {}  // K^{-1} and M^{-1} are formed when the map is built
-  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { g.simplified_update<N, S>(h, F.data(), update.data()); }
-  double apply(const Eigen::VectorXd& update) {
-    const int n = N == Eigen::Dynamic ? g.n_ : N, size = fixed_or<S>(g.s_) * n;
-    double* __restrict points = g.points_.data() + n;
+  double apply(const Eigen::VectorXd&) {
+    const int n = fixed_or<N>(g.n_), size = fixed_or<R>(static_cast<int>(g.iteration_nodes_.size())) * n;
     double largest = 0.0, origin = 0.0;
     for (int k = 0; k < size; ++k) {
-      points[k] -= update[k];
-      largest = std::max(largest, std::abs(points[k]));
+      g.node_offsets_[k] = g.next_offsets_[k];
+      largest = std::max(largest, std::abs(g.node_offsets_[k]));
     }
     for (int c = 0; c < n; ++c) origin = std::max(origin, std::abs(g.origin_[c]));
     return origin + largest;
   }
-  // impulse_ -= (dS/dq^0 + p0) + sum_{0 < nu < s} dS/dq^nu at the updated points, dS/dq^nu less
-  // (1/h) M sum_mu K_numu update^mu (dS/dq^0 from gradient_, the others from F).
-  void finish(const Eigen::VectorXd& update) {
-    const int n = N == Eigen::Dynamic ? g.n_ : N, s = fixed_or<S>(g.s_);
-    const double* __restrict K = g.stiffness_.data();
-    const double* __restrict M = g.mass_matrix_.data();
-    double* __restrict kinetic = g.kinetic_.data();
-    double* __restrict impulse = g.impulse_.data();
-    for (int nu = 0; nu < s; ++nu) {
-      for (int c = 0; c < n; ++c) kinetic[c] = 0.0;
-      for (int mu = 1; mu <= s; ++mu)
-        for (int c = 0; c < n; ++c) kinetic[c] += K[nu + mu * (s + 1)] * update[(mu - 1) * n + c];
-      for (int c = 0; c < n; ++c) {
-        double m = 0.0;
-        for (int d = 0; d < n; ++d) m += M[c + d * n] * kinetic[d];
-        if (nu == 0)
-          impulse[c] -= (g.gradient_[c] - m / h) + p0[c];
-        else
-          impulse[c] -= residual[nu * n + c] - m / h;
-      }
-    }
-  }
+  void finish(const Eigen::VectorXd&) {}
 };
 
-template <int N, int S>
-bool GalerkinDiscreteLagrangian::solve_simplified(double h, const double* p0) {
-  Simplified<N, S> equations{*this, h, p0};
-  return solver_.solve(equations, statistics_).converged();
+// The step by the node iteration from its warm start. Converged, the step is that of the forces
+// of the last evaluation: q1 - q0 = X^s by end_map_ (into points_' last column), and p1 - p0 =
+// impulse_ = h sum_j b_j g_j, the sum of the step's equations (see action()), all of which those
+// forces satisfy with the X^mu they give. False when it does not converge (the caller solves the
+// step again with the exact Jacobian).
+template <int N, int R>
+bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool continues) {
+  const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
+  for (int c = 0; c < n; ++c) {
+    double u = 0.0;
+    for (int d = 0; d < n; ++d) u += inverse_mass_.data()[c + d * n] * p0[d];
+    velocity0_[c] = u;
+  }
+  if (continues) {
+    predict_forces<N, R>();
+    offsets_from_forces<N, R>(node_map_, h, predicted_accelerations_.data(), node_offsets_.data());
+  } else {  // the straight line with the velocity of the inverse Legendre transform, u0
+    for (int j = 0; j < nodes; ++j)
+      for (int c = 0; c < n; ++c) node_offsets_[j * n + c] = nodes_[iteration_nodes_[j]] * h * velocity0_[c];
+  }
+  NodeIteration<N, R> iteration{*this, h, p0};
+  if (!solver_.solve(iteration, statistics_).converged()) return false;
+  offsets_from_forces<N, R>(end_map_, h, node_accelerations_.data(), points_.col(s_).data());
+  for (int c = 0; c < n; ++c) {
+    double sum = 0.0;
+    for (int j = 0; j < nodes; ++j) sum += weights_[iteration_nodes_[j]] * node_forces_.data()[j * n + c];
+    impulse_[c] = h * sum;
+  }
+  return true;
 }
 
-// The warm start: the step's equations are linear in the control points once the forces g_i are
-// given. With the forces of the last steps continued as the polynomial through their nodes,
-// g_j ~ sum_m l_m(c_j) g_m (force_prediction_ holds those weights times b_j l_nu(c_j)), they are
-// solved for the control points by the simplified Jacobian. The forces along the motion are as
-// smooth as the motion: through the last step's r nodes the extrapolated forces are off by O(h^r),
-// the control points by O(h^(r+2)) (the kinetic part's inverse is O(h), times h); with two more
-// nodes of the step before (as Hairer's gni_irk2 starts from s + 2 forces), by O(h^(r+2)) and
-// O(h^(r+4)). Against O(h^(s+1)) for the last step's interpolant continued (which Newton's method
-// with the exact Jacobian starts from).
-template <int N, int S>
-void GalerkinDiscreteLagrangian::predict(const double* p0, double h) {
-  const int n = N == Eigen::Dynamic ? n_ : N, s = fixed_or<S>(s_), stride = static_cast<int>(force_history_.cols()),
-            count = two_steps_back_ ? stride : stride / 2;  // the columns in use
-  const double* __restrict forces = force_history_.data();
-  const double* __restrict weights = force_prediction_[two_steps_back_ ? 1 : 0].data();
-  double* __restrict equations = predicted_.data();
-  for (int nu = 0; nu < s; ++nu)
+// The warm start: the forces along the motion are as smooth as the motion, and the polynomial
+// through the last steps' forces at their nodes continued to this step's nodes predicts them,
+// through the last step's R nodes to O(h^R), through those and two more of the step before (as
+// Hairer's gni_irk2 starts from s + 2 forces) to O(h^(R+2)); the offsets they give are off by h^2
+// times that. Against O(h^(s+1)) for the last step's interpolant continued (which Newton's method
+// with the exact Jacobian starts from). Into predicted_accelerations_ as M^{-1} g_j.
+template <int N, int R>
+void GalerkinDiscreteLagrangian::predict_forces() {
+  const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size())),
+            stride = 2 * nodes, count = two_steps_back_ ? stride : nodes;  // the history's columns in use
+  const double* __restrict history = force_history_.data();
+  const double* __restrict E = force_extrapolation_[two_steps_back_ ? 1 : 0].data();
+  const double* __restrict M_inverse = inverse_mass_.data();
+  double* __restrict forces = predicted_forces_.data();
+  double* __restrict predicted = predicted_accelerations_.data();
+  for (int j = 0; j < nodes; ++j) {
+    double* g = forces + j * n;
+    for (int c = 0; c < n; ++c) g[c] = 0.0;
+    for (int m = 0; m < count; ++m)
+      for (int c = 0; c < n; ++c) g[c] += E[m + j * stride] * history[m * n + c];
     for (int c = 0; c < n; ++c) {
-      double sum = 0.0;
-      for (int m = 0; m < count; ++m) sum += weights[m + nu * stride] * forces[m * n + c];
-      equations[nu * n + c] = h * sum + (nu == 0 ? p0[c] : 0.0);
+      double a = 0.0;
+      for (int d = 0; d < n; ++d) a += M_inverse[c + d * n] * g[d];
+      predicted[j * n + c] = a;
     }
-  simplified_update<N, S>(h, equations, change_.data());
-  for (int k = 0; k < s * n; ++k) points_.data()[n + k] = -change_[k];
+  }
 }
 
 // The equations dS/dq^nu (+ f_d^nu when forced) = 0, nu in [first_equation, first_equation +
@@ -819,16 +865,10 @@ void GalerkinDiscreteLagrangian::factorize_sparse() {
                            std::nan(""));
 }
 
-// Newton's method (solve/newton.hpp: its stopping rule, and the update from the last residual
-// always applied). The step's equations of a constant mass matrix are solved by simplified Newton
-// first, from the warm start; where that does not converge, again from the warm start with the
-// exact Jacobian.
+// Newton's method with the exact Jacobian (solve/newton.hpp: its stopping rule, and the update
+// from the last residual always applied).
 void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
                                         int blocks, const double* p0, bool forced) {
-  if (simplified_solve_ != nullptr && p0 != nullptr) {
-    if ((this->*simplified_solve_)(h, p0)) return;
-    warm_start(origin_.data(), p0, h);  // the same warm start again (q0 = origin_)
-  }
   if (lagrangian_.sparse()) prepare_sparse(first_unknown, first_equation, blocks);
   const int size = blocks * n_;
   if (!lagrangian_.sparse() && dense_.jacobian.rows() != size) dense_ = DenseLinearization(size);
@@ -851,16 +891,15 @@ void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unkno
   for (int nu = 0; nu <= s_; ++nu) impulse_ -= change_.segment(nu * n_, n_);
 }
 
-// The initial guess: the previous step's interpolant continued past its end when this step
-// follows it, otherwise a straight line with the velocity of the inverse Legendre transform.
-// Offsets from q0 = the last step's q1: q(1 + d_nu) - q1 = sum_mu l_mu(1 + d_nu) (q_prev^mu -
-// q_prev^0) - (q_prev^s - q_prev^0).
-bool GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h) {
-  const Eigen::Map<const Eigen::VectorXd> start(q0, n_);
-  const bool continues = has_previous_ && previous_h_ == h && previous_end_ == start;
-  origin_ = start;
-  if (continues && predict_ != nullptr) {
-    (this->*predict_)(p0, h);
+// The initial guess: where the node iteration applies, the control points of the forces it
+// predicted (see predict_forces()) when this step follows the last; else the previous step's
+// interpolant continued past its end when this step follows it; otherwise a straight line with
+// the velocity of the inverse Legendre transform. Offsets from q0 = the last step's q1:
+// q(1 + d_nu) - q1 = sum_mu l_mu(1 + d_nu) (q_prev^mu - q_prev^0) - (q_prev^s - q_prev^0).
+void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h, bool continues) {
+  if (continues && node_solve_ != nullptr) {
+    offsets_from_forces<Eigen::Dynamic, Eigen::Dynamic>(control_map_, h, predicted_accelerations_.data(),
+                                                        points_.col(1).data());
   } else if (continues) {
     points_.noalias() = previous_ * extrapolation_;
     points_.colwise() -= previous_.col(s_);
@@ -869,7 +908,6 @@ bool GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, 
     for (int nu = 0; nu <= s_; ++nu) points_.col(nu) = (basis_.control_times[nu] * h) * velocity_;
   }
   points_.col(0).setZero();
-  return continues;
 }
 
 // q1 = q0 + (q^s - q^0), and p1 = D2 L_d + f_d^s written as p0 plus its change: the equations
@@ -891,8 +929,13 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
     carry_p_.setZero();
   }
   t_ = t0;
-  const bool continues = warm_start(q0, p0, h);
-  newton(h, 1, 0, s_, p0, !forces_.empty());  // impulse_ is then p1 - p0 (the solvers' finish())
+  const bool continues = has_previous_ && previous_h_ == h && previous_end_ == start;
+  origin_ = start;
+  // impulse_ is then p1 - p0, q^s - q^0 that of q1 (solve_at_nodes, or the Equations' finish())
+  if (node_solve_ == nullptr || !(this->*node_solve_)(p0, h, continues)) {
+    warm_start(q0, p0, h, continues);
+    newton(h, 1, 0, s_, p0, !forces_.empty());
+  }
   Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);
   previous_end_ = start;
   compensated_add(previous_end_, points_.col(s_), carry_q_);
@@ -900,7 +943,7 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   compensated_add(end_p_, impulse_, carry_p_);
   end = previous_end_;
   momentum1 = end_p_;
-  if (predict_ != nullptr) {  // the history shifts by a step
+  if (node_solve_ != nullptr) {  // the history shifts by a step
     const Eigen::Index r = node_forces_.cols();
     force_history_.rightCols(r) = force_history_.leftCols(r);
     force_history_.leftCols(r) = node_forces_;

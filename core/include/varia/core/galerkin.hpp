@@ -9,12 +9,15 @@
 // the equations are
 //   p0 delta_nu0 + (1/h) sum_mu K_numu M q^mu - h sum_i b_i l_nu(c_i) grad V(q(c_i h)) = 0,
 // with the stiffness matrix K_numu = sum_i b_i l'_nu(c_i) l'_mu(c_i) of the interpolant, and their
-// kinetic part (1/h) K (x) M, constant, is the Jacobian that the iteration keeps (factorized once,
-// when the map is built): each iteration evaluates the forces dL/dq at the nodes only, no
-// Hessian. This is the fixed-point iteration of the s-stage Gauss method (s Gauss-Legendre
-// points) for q'' = -M^{-1} grad V, whose contraction is O(h^2 |M^{-1} V''|). Where it does not
-// contract (theta >= 1/2: large steps, stiff forces) the step is solved again with the exact
-// Jacobian.
+// kinetic part (1/h) K (x) M, constant, is the Jacobian that the iteration keeps. With the forces
+// at the nodes given, the equations are linear: the control points, and the nodes' positions on
+// the interpolant, are a fixed linear map of (M^{-1} p0, M^{-1} grad V at the nodes), formed once
+// when the map is built. The iteration therefore runs in the nodes' positions: each pass evaluates
+// the forces at the nodes (in one plugin call) and applies that map, with no Hessian, no
+// velocity, no control point. This is the fixed-point iteration of the s-stage Gauss method (s
+// Gauss-Legendre points) for q'' = -M^{-1} grad V, whose contraction is O(h^2 |M^{-1} V''|). Where
+// it does not contract (theta >= 1/2: large steps, stiff forces) the step is solved again with the
+// exact Jacobian.
 // Forces (force.hpp) enter by the discrete Lagrange-d'Alembert principle (Marsden & West 2001,
 // sec. 3.2) with the discrete forces taken through the same quadrature,
 //   f_d^nu = h sum_i b_i l_nu(c_i) f(t + c_i h, q(c_i h), qdot(c_i h)),
@@ -117,30 +120,33 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void newton(double h, int first_unknown, int first_equation, int blocks, const double* p0,
               bool forced);
   struct Equations;  // those equations as a NewtonSolver system
-  // Simplified Newton on the step's equations (nu = 0..s-1, unknowns q^1..q^s) of a constant mass
-  // matrix: their residual from the forces at the nodes, the update by the kinetic part's inverse,
-  // the solve (true when it converged), and the warm start predicted from the last step's forces.
-  // Compiled for N = n <= 4 and Dynamic, chosen once (simplified_solve_, predict_).
+  // Simplified Newton for a constant mass matrix, in the nodes' coordinates (see the top):
+  // whether it applies (and its linear maps, formed once), the extrapolation of the last steps'
+  // forces to the next step's nodes, the fixed point as a NewtonSolver system, its solve (true when
+  // it converged; else the step is solved again with the exact Jacobian, from warm_start()), and
+  // the linear map from the forces at the nodes to offsets. Compiled for N = n <= 4 and R = the
+  // nodes of nonzero weight <= 7 where both are small (loops of a fixed length), Eigen::Dynamic
+  // otherwise, chosen once (node_solve_).
   bool simplified_applies();
   Eigen::MatrixXd extrapolation_to_nodes(const std::vector<double>& times) const;
-  // N = n and S = s where both are small (loops of a fixed length), else Eigen::Dynamic.
-  template <int N, int S>
-  struct Simplified;  // those equations as a NewtonSolver system
-  template <int N, int S>
-  double simplified_residual(double h, const double* p0, double* F);
-  template <int N, int S>
-  void simplified_update(double h, const double* F, double* update);
-  template <int N, int S>
-  bool solve_simplified(double h, const double* p0);
-  template <int N, int S>
-  void predict(const double* p0, double h);
-  using SimplifiedFunction = bool (GalerkinDiscreteLagrangian::*)(double, const double*);
-  using PredictFunction = void (GalerkinDiscreteLagrangian::*)(const double*, double);
+  template <int N, int R>
+  struct NodeIteration;
+  template <int N, int R>
+  double node_residual(double h, const double* p0, double* F);
+  template <int N, int R>
+  bool solve_at_nodes(const double* p0, double h, bool continues);
+  template <int N, int R>
+  void predict_forces();
+  template <int N, int R>
+  void offsets_from_forces(const Eigen::MatrixXd& map, double h, const double* forces, double* offsets) const;
+  using NodeSolveFunction = bool (GalerkinDiscreteLagrangian::*)(const double*, double, bool);
   void factorize_sparse();
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
   void gradient_after_update(double h, int first_unknown, const Eigen::VectorXd& update, bool forced);
-  bool warm_start(const double* q0, const double* p0, double h);  // true: the step continues the last one
+  // The control points' initial guess for Newton's method with the exact Jacobian; `continues`:
+  // the step continues the last one (same h, from its q1).
+  void warm_start(const double* q0, const double* p0, double h, bool continues);
   // Degree 1 with nodes only at 0 and 1 and a constant mass matrix M: the IDEL equations are
   // explicit (Stormer-Verlet for the trapezoid rule), solved without Newton. For a dense
   // Lagrangian the steps are compiled for N = n (fixed-size arithmetic, the state in registers
@@ -172,7 +178,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // eps |v|, not eps |q|/h, which would random-walk the momentum (docs/hard-cases.md, Kepler).
   Eigen::VectorXd origin_;
   Eigen::MatrixXd points_;    // n x (s+1), offsets of the control points as columns
-  Eigen::MatrixXd previous_;  // the last step's offsets (kept where predict() does not apply)
+  Eigen::MatrixXd previous_;  // the last step's offsets (kept where the node iteration does not apply)
   Eigen::VectorXd previous_end_;  // the last step's q1
   double previous_h_ = 0.0;
   bool has_previous_ = false;
@@ -208,23 +214,29 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // and, at the last (q1, p1) with step previous_h_, dL/dq and the increment h v (reused by a step
   // from there: one gradient evaluation per step).
   AdvanceFunction explicit_advance_ = nullptr;
-  // Simplified Newton (constant mass matrix): the stiffness matrix K ((s+1) x (s+1)), the inverse
-  // of its block K(0..s-1, 1..s), and M^{-1} (inverse_mass_). Its warm start (predict()): the forces dL/dq at the
-  // nodes of the last evaluation (node_forces_, n x r) and of the last two steps (force_history_,
-  // n x 2r: the last step's nodes, then the one's before), and force_prediction_[k] (2r x s):
-  // the extrapolation of those forces to the next step's nodes (the Lagrange basis through the
-  // last step's nodes, k = 0, or through those and the two latest distinct nodes of the step
-  // before, k = 1, at the next step's nodes) times the weights b_j l_nu(c_j) of the step's
-  // equations; two_steps_back_ says whether the step before the last is in the history (the last
-  // continued it with the same h). Workspace: the equations' value at the predicted forces (s n),
-  // and products of the kinetic part ((s+1) n).
-  SimplifiedFunction simplified_solve_ = nullptr;
-  PredictFunction predict_ = nullptr;
-  Eigen::MatrixXd stiffness_, stiffness_inverse_;
-  Eigen::MatrixXd node_forces_, force_history_, force_prediction_[2];
+  // Simplified Newton in the nodes' coordinates (constant mass matrix). M^{-1} (inverse_mass_);
+  // the velocity u0 = M^{-1} p0 of the step; the maps from (u0, the forces' M^{-1} g_i) to offsets
+  // (see offsets_from_forces): to the nodes' (node_map_, R x (1 + R)) and to the control points'
+  // q^1..q^s (control_map_, s x (1 + R); end_map_ its last row, q1's); the indices of the nodes of nonzero
+  // weight (the iteration's nodes, R of them) in the quadrature; their offsets from q0 at the
+  // current iterate and at the next (node_offsets_, next_offsets_, R n), their forces g_i = dL/dq
+  // and M^{-1} g_i at the last evaluation (node_forces_, node_accelerations_) and as predicted from the last steps
+  // (predicted_forces_, predicted_accelerations_); the batch of (q, v) points handed to the plugin (v = 0) and its
+  // gradients [L_q, L_v] (2 n R each). The warm start: the forces dL/dq at the nodes of the last
+  // two steps (force_history_, n x 2R: the last step's, then the one's before), extrapolated to
+  // the next step's nodes by force_extrapolation_[k] (2R x R): the Lagrange basis through the last
+  // step's nodes (k = 0), or through those and the two latest distinct nodes of the step before
+  // (k = 1); two_steps_back_ says whether the step before the last is in the history (the last
+  // continued it with the same h).
+  NodeSolveFunction node_solve_ = nullptr;
+  Eigen::MatrixXd node_map_, control_map_, end_map_;
+  double mass_norm_ = 0.0;  // |M|_inf
+  std::vector<int> iteration_nodes_;
+  Eigen::VectorXd velocity0_, node_offsets_, next_offsets_, node_accelerations_, predicted_forces_,
+      predicted_accelerations_;
+  Eigen::VectorXd node_points_, node_gradients_;
+  Eigen::MatrixXd node_forces_, force_history_, force_extrapolation_[2];  // n x R, n x 2R, 2R x R
   bool two_steps_back_ = false;
-  Eigen::VectorXd predicted_, kinetic_;
-  Eigen::VectorXd node_points_, node_gradients_;  // the nodes' (q, v) and [L_q, L_v], 2n each
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;
   Eigen::SparseMatrix<double> sparse_mass_;  // the sparse explicit form's M, and its Cholesky factor
