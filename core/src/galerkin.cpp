@@ -281,12 +281,12 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
   mass_norm_ = mass_matrix_.cwiseAbs().rowwise().sum().maxCoeff();
   end_map_ = control_map_.bottomRows(1);
   velocity0_.resize(n_);
-  for (Eigen::VectorXd* v : {&node_offsets_, &next_offsets_, &node_accelerations_, &predicted_forces_, &predicted_accelerations_})
+  for (Eigen::VectorXd* v : {&node_offsets_, &next_offsets_, &node_accelerations_, &predicted_accelerations_})
     v->resize(R * n_);
   node_points_ = Eigen::VectorXd::Zero(2 * n_ * R);  // the velocities stay 0 (L_q does not depend on v)
   node_gradients_.resize(2 * n_ * R);
   node_forces_ = Eigen::MatrixXd::Zero(n_, R);
-  force_history_ = Eigen::MatrixXd::Zero(n_, 2 * R);
+  acceleration_history_ = Eigen::MatrixXd::Zero(n_, 2 * R);
   // The history's times, in steps from the next step's start: the last step's nodes c_j - 1, the
   // step's before c_j - 2 (NaN: not used).
   std::vector<double> last(2 * R, NAN), two_back(2 * R, NAN);
@@ -298,6 +298,11 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
   }
   force_extrapolation_[0] = extrapolation_to_nodes(last);
   force_extrapolation_[1] = extrapolation_to_nodes(two_back);
+  for (int k = 0; k < 2; ++k) {  // the nodes' offsets from the history: [u0's | W E_k^T]
+    prediction_map_[k].resize(R, 1 + 2 * R);
+    prediction_map_[k].col(0) = node_map_.col(0);
+    prediction_map_[k].rightCols(2 * R).noalias() = node_map_.rightCols(R) * force_extrapolation_[k].transpose();
+  }
   return true;
 }
 
@@ -522,10 +527,8 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
     const double b = weights_[i];
     S += h * b * L;
     if (order == Order::value) continue;
-    for (int c = 0; c < n; ++c) {
-      impulse_[c] += (h * b) * grad_[c];
-      if (node_solve_ != nullptr) node_forces_(c, j) = grad_[c];
-    }
+    for (int c = 0; c < n; ++c) impulse_[c] += (h * b) * grad_[c];
+    if (node_solve_ != nullptr) node_accelerations_.segment(j * n, n).noalias() = inverse_mass_ * grad_.head(n);
     ++j;
     if (forced) add_forces(i, h, order);
     if (order == Order::hessian && sparse)
@@ -648,14 +651,15 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
 // product's setup costs more than its arithmetic.
 
 // offsets(j) = h (map(j, 0) u0 + h sum_i map(j, 1 + i) a_i) for the rows j of map, with
-// u0 = velocity0_ and a_i = M^{-1} g_i the forces' accelerations at the R nodes (n each).
+// u0 = velocity0_ and a_i = M^{-1} g_i the forces' accelerations at C points (n each): the R nodes,
+// or the 2R of the history.
 // Offsets from q0, numbers of size h |v|: q0 + offset rounds to eps |q0|, where forming the
 // positions themselves would add eps |q0| at every step (docs/hard-cases.md, Kepler).
-template <int N, int R>
+template <int N, int C>
 [[gnu::always_inline]] inline void GalerkinDiscreteLagrangian::offsets_from_forces(const Eigen::MatrixXd& map, double h,
                                                                                   const double* __restrict accelerations,
                                                                                   double* __restrict offsets) const {
-  const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size())),
+  const int n = fixed_or<N>(n_), nodes = fixed_or<C>(static_cast<int>(map.cols()) - 1),
             rows = static_cast<int>(map.rows());
   const double* __restrict W = map.data();
   const double* __restrict u0 = velocity0_.data();
@@ -670,7 +674,7 @@ template <int N, int R>
 // The fixed point's residual at the nodes' offsets D (node_offsets_): the forces g_j = dL/dq at
 // q0 + D_j in one plugin call (Lagrangian::gradients; v = 0: for this Lagrangian L_q does not
 // depend on v), kept with M^{-1} g_j, the offsets D' that the step's equations give for those
-// forces (into next_offsets_), and F = M (D - D') / h (R n). F is the equations' residual in their
+// forces (into next_offsets_), and F = M (D - D') / h (R n), with 1/h and |p0| given (once a step). F is the equations' residual in their
 // own units, momentum (at X, with X' the control points of D', the residual of equation nu is
 // (1/h) M sum_mu K_numu (X^mu - X'^mu)): the stopping rule's tolerance means what it means for
 // the equations, and its yardstick is theirs, |p0| and the kinetic terms |M D'| / h. (The
@@ -678,7 +682,7 @@ template <int N, int R>
 // rule stopped with systematic errors h^-1 times larger, and the s = 6 Gauss steps of the
 // pendulum ended 1.6e-13 from gni_irk2's instead of 2e-15.)
 template <int N, int R>
-double GalerkinDiscreteLagrangian::node_residual(double h, const double* __restrict p0, double* __restrict F) {
+double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, double momentum, double* __restrict F) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
   const double* __restrict q0 = origin_.data();
   const double* __restrict D = node_offsets_.data();
@@ -702,16 +706,15 @@ double GalerkinDiscreteLagrangian::node_residual(double h, const double* __restr
     }
   }
   offsets_from_forces<N, R>(node_map_, h, accelerations, next);
-  double largest = 0.0, momentum = 0.0;
+  double largest = 0.0;
   for (int j = 0; j < nodes; ++j)
     for (int c = 0; c < n; ++c) {
       double f = 0.0;
       for (int d = 0; d < n; ++d) f += M[c + d * n] * (D[j * n + d] - next[j * n + d]);
-      F[j * n + c] = f / h;
+      F[j * n + c] = f * inverse_h;
       largest = std::max(largest, std::abs(next[j * n + c]));
     }
-  for (int c = 0; c < n; ++c) momentum = std::max(momentum, std::abs(p0[c]));
-  return std::max(momentum, mass_norm_ * largest / h);
+  return std::max(momentum, mass_norm_ * largest * inverse_h);
 }
 
 // The fixed point D = D'(g(q0 + D)) as a NewtonSolver system with the Jacobian M / h at every node
@@ -721,12 +724,12 @@ double GalerkinDiscreteLagrangian::node_residual(double h, const double* __restr
 template <int N, int R>
 struct GalerkinDiscreteLagrangian::NodeIteration {
   GalerkinDiscreteLagrangian& g;
-  double h;
-  const double* p0;
+  double h, inverse_h;
+  double momentum;  // |p0|
 
   int size() const { return static_cast<int>(g.node_offsets_.size()); }
   bool simplified() const { return true; }
-  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.node_residual<N, R>(h, p0, F.data()); }
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.node_residual<N, R>(h, inverse_h, momentum, F.data()); }
   void factorize() {}
   void solve(const Eigen::VectorXd&, Eigen::VectorXd& update) {
     const int size = fixed_or<R>(static_cast<int>(g.iteration_nodes_.size())) * fixed_or<N>(g.n_);
@@ -753,19 +756,22 @@ struct GalerkinDiscreteLagrangian::NodeIteration {
 template <int N, int R>
 bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool continues) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
+  double momentum = 0.0;
   for (int c = 0; c < n; ++c) {
     double u = 0.0;
     for (int d = 0; d < n; ++d) u += inverse_mass_.data()[c + d * n] * p0[d];
     velocity0_[c] = u;
+    momentum = std::max(momentum, std::abs(p0[c]));
   }
   if (continues) {
-    predict_forces<N, R>();
-    offsets_from_forces<N, R>(node_map_, h, predicted_accelerations_.data(), node_offsets_.data());
+    constexpr int history = R == Eigen::Dynamic ? Eigen::Dynamic : 2 * R;
+    offsets_from_forces<N, history>(prediction_map_[two_steps_back_ ? 1 : 0], h, acceleration_history_.data(),
+                                    node_offsets_.data());
   } else {  // the straight line with the velocity of the inverse Legendre transform, u0
     for (int j = 0; j < nodes; ++j)
       for (int c = 0; c < n; ++c) node_offsets_[j * n + c] = nodes_[iteration_nodes_[j]] * h * velocity0_[c];
   }
-  NodeIteration<N, R> iteration{*this, h, p0};
+  NodeIteration<N, R> iteration{*this, h, 1.0 / h, momentum};
   if (!solver_.solve(iteration, statistics_).converged()) return false;
   offsets_from_forces<N, R>(end_map_, h, node_accelerations_.data(), points_.col(s_).data());
   for (int c = 0; c < n; ++c) {
@@ -781,27 +787,19 @@ bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool
 // through the last step's R nodes to O(h^R), through those and two more of the step before (as
 // Hairer's gni_irk2 starts from s + 2 forces) to O(h^(R+2)); the offsets they give are off by h^2
 // times that. Against O(h^(s+1)) for the last step's interpolant continued (which Newton's method
-// with the exact Jacobian starts from). Into predicted_accelerations_ as M^{-1} g_j.
-template <int N, int R>
-void GalerkinDiscreteLagrangian::predict_forces() {
-  const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size())),
-            stride = 2 * nodes, count = two_steps_back_ ? stride : nodes;  // the history's columns in use
-  const double* __restrict history = force_history_.data();
-  const double* __restrict E = force_extrapolation_[two_steps_back_ ? 1 : 0].data();
-  const double* __restrict M_inverse = inverse_mass_.data();
-  double* __restrict forces = predicted_forces_.data();
-  double* __restrict predicted = predicted_accelerations_.data();
-  for (int j = 0; j < nodes; ++j) {
-    double* g = forces + j * n;
-    for (int c = 0; c < n; ++c) g[c] = 0.0;
-    for (int m = 0; m < count; ++m)
-      for (int c = 0; c < n; ++c) g[c] += E[m + j * stride] * history[m * n + c];
+// with the exact Jacobian starts from). The history holds the accelerations M^{-1} g (M^{-1} is
+// linear): the node iteration starts from their offsets, by prediction_map_ (the extrapolation and
+// node_map_ in one); this, for the exact Jacobian's start where the iteration did not converge,
+// forms the predicted accelerations at the nodes themselves, into predicted_accelerations_.
+void GalerkinDiscreteLagrangian::predict_accelerations() {
+  const Eigen::MatrixXd& E = force_extrapolation_[two_steps_back_ ? 1 : 0];
+  const int n = n_, R = static_cast<int>(E.cols());
+  for (int j = 0; j < R; ++j)
     for (int c = 0; c < n; ++c) {
       double a = 0.0;
-      for (int d = 0; d < n; ++d) a += M_inverse[c + d * n] * g[d];
-      predicted[j * n + c] = a;
+      for (int m = 0; m < E.rows(); ++m) a += E(m, j) * acceleration_history_(c, m);
+      predicted_accelerations_[j * n + c] = a;
     }
-  }
 }
 
 // The equations dS/dq^nu (+ f_d^nu when forced) = 0, nu in [first_equation, first_equation +
@@ -892,12 +890,13 @@ void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unkno
 }
 
 // The initial guess: where the node iteration applies, the control points of the forces it
-// predicted (see predict_forces()) when this step follows the last; else the previous step's
+// predicted (see predict_accelerations()) when this step follows the last; else the previous step's
 // interpolant continued past its end when this step follows it; otherwise a straight line with
 // the velocity of the inverse Legendre transform. Offsets from q0 = the last step's q1:
 // q(1 + d_nu) - q1 = sum_mu l_mu(1 + d_nu) (q_prev^mu - q_prev^0) - (q_prev^s - q_prev^0).
 void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h, bool continues) {
   if (continues && node_solve_ != nullptr) {
+    predict_accelerations();
     offsets_from_forces<Eigen::Dynamic, Eigen::Dynamic>(control_map_, h, predicted_accelerations_.data(),
                                                         points_.col(1).data());
   } else if (continues) {
@@ -945,8 +944,8 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   momentum1 = end_p_;
   if (node_solve_ != nullptr) {  // the history shifts by a step
     const Eigen::Index r = node_forces_.cols();
-    force_history_.rightCols(r) = force_history_.leftCols(r);
-    force_history_.leftCols(r) = node_forces_;
+    acceleration_history_.rightCols(r) = acceleration_history_.leftCols(r);
+    acceleration_history_.leftCols(r) = node_accelerations_.reshaped(n_, r);
     two_steps_back_ = continues;
   } else
     previous_ = points_;

@@ -132,12 +132,11 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N, int R>
   struct NodeIteration;
   template <int N, int R>
-  double node_residual(double h, const double* p0, double* F);
+  double node_residual(double h, double inverse_h, double momentum, double* F);
   template <int N, int R>
   bool solve_at_nodes(const double* p0, double h, bool continues);
-  template <int N, int R>
-  void predict_forces();
-  template <int N, int R>
+  void predict_accelerations();
+  template <int N, int C>
   void offsets_from_forces(const Eigen::MatrixXd& map, double h, const double* forces, double* offsets) const;
   using NodeSolveFunction = bool (GalerkinDiscreteLagrangian::*)(const double*, double, bool);
   void factorize_sparse();
@@ -217,25 +216,26 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // Simplified Newton in the nodes' coordinates (constant mass matrix). M^{-1} (inverse_mass_);
   // the velocity u0 = M^{-1} p0 of the step; the maps from (u0, the forces' M^{-1} g_i) to offsets
   // (see offsets_from_forces): to the nodes' (node_map_, R x (1 + R)) and to the control points'
-  // q^1..q^s (control_map_, s x (1 + R); end_map_ its last row, q1's); the indices of the nodes of nonzero
-  // weight (the iteration's nodes, R of them) in the quadrature; their offsets from q0 at the
-  // current iterate and at the next (node_offsets_, next_offsets_, R n), their forces g_i = dL/dq
-  // and M^{-1} g_i at the last evaluation (node_forces_, node_accelerations_) and as predicted from the last steps
-  // (predicted_forces_, predicted_accelerations_); the batch of (q, v) points handed to the plugin (v = 0) and its
-  // gradients [L_q, L_v] (2 n R each). The warm start: the forces dL/dq at the nodes of the last
-  // two steps (force_history_, n x 2R: the last step's, then the one's before), extrapolated to
-  // the next step's nodes by force_extrapolation_[k] (2R x R): the Lagrange basis through the last
+  // q^1..q^s (control_map_, s x (1 + R); end_map_ its last row, q1's); the indices of the nodes of
+  // nonzero weight (the iteration's nodes, R of them) in the quadrature; their offsets from q0 at
+  // the current iterate and at the next (node_offsets_, next_offsets_, R n), their forces g_i =
+  // dL/dq and M^{-1} g_i at the last evaluation (node_forces_, node_accelerations_) and M^{-1} g_i
+  // as predicted from the last steps (predicted_accelerations_, for the exact Jacobian's start);
+  // the batch of (q, v) points handed to the plugin (v = 0) and its gradients [L_q, L_v] (2 n R
+  // each). The warm start: the accelerations M^{-1} dL/dq at the nodes of the last two steps
+  // (acceleration_history_, n x 2R: the last step's, then the one's before), extrapolated to the
+  // next step's nodes by force_extrapolation_[k] (2R x R): the Lagrange basis through the last
   // step's nodes (k = 0), or through those and the two latest distinct nodes of the step before
-  // (k = 1); two_steps_back_ says whether the step before the last is in the history (the last
-  // continued it with the same h).
+  // (k = 1), and the nodes' offsets they give, prediction_map_[k] (R x (1 + 2R): node_map_'s
+  // column of u0, then its forces' columns times E_k^T); two_steps_back_ says whether the step
+  // before the last is in the history (the last continued it with the same h).
   NodeSolveFunction node_solve_ = nullptr;
-  Eigen::MatrixXd node_map_, control_map_, end_map_;
+  Eigen::MatrixXd node_map_, control_map_, end_map_, prediction_map_[2];
   double mass_norm_ = 0.0;  // |M|_inf
   std::vector<int> iteration_nodes_;
-  Eigen::VectorXd velocity0_, node_offsets_, next_offsets_, node_accelerations_, predicted_forces_,
-      predicted_accelerations_;
+  Eigen::VectorXd velocity0_, node_offsets_, next_offsets_, node_accelerations_, predicted_accelerations_;
   Eigen::VectorXd node_points_, node_gradients_;
-  Eigen::MatrixXd node_forces_, force_history_, force_extrapolation_[2];  // n x R, n x 2R, 2R x R
+  Eigen::MatrixXd node_forces_, acceleration_history_, force_extrapolation_[2];  // n x R, n x 2R, 2R x R
   bool two_steps_back_ = false;
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;
