@@ -160,10 +160,15 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
     entries_.push_back(Entry{forces_.rows()[e], forces_.cols()[e] % n_, false, forces_.cols()[e] >= n_});
   action_ = for_dimension(n_, [](auto N) -> ActionFunction { return &GalerkinDiscreteLagrangian::action_for<decltype(N)::value>; });
   explicit_advance_ = explicit_form(quadrature);
-  if (explicit_advance_ == nullptr && simplified_applies())
-    node_solve_ = for_shape(n_, static_cast<int>(iteration_nodes_.size()), [](auto N, auto R) -> NodeSolveFunction {
-      return &GalerkinDiscreteLagrangian::solve_at_nodes<decltype(N)::value, decltype(R)::value>;
-    });
+  if (explicit_advance_ != nullptr) return;
+  node_iteration_ = simplified_applies();
+  step_ = node_iteration_
+              ? for_shape(n_, static_cast<int>(iteration_nodes_.size()), [](auto N, auto R) -> StepFunction {
+                  return &GalerkinDiscreteLagrangian::step_at<decltype(N)::value, decltype(R)::value>;
+                })
+              : for_dimension(n_, [](auto N) -> StepFunction {
+                  return &GalerkinDiscreteLagrangian::step_at<decltype(N)::value, Eigen::Dynamic>;
+                });
 }
 
 const EvaluationCounters& GalerkinDiscreteLagrangian::evaluations() const {
@@ -285,7 +290,6 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
     v->resize(R * n_);
   node_points_ = Eigen::VectorXd::Zero(2 * n_ * R);  // the velocities stay 0 (L_q does not depend on v)
   node_gradients_.resize(2 * n_ * R);
-  node_forces_ = Eigen::MatrixXd::Zero(n_, R);
   acceleration_history_ = Eigen::MatrixXd::Zero(n_, 2 * R);
   // The history's times, in steps from the next step's start: the last step's nodes c_j - 1, the
   // step's before c_j - 2 (NaN: not used).
@@ -452,8 +456,13 @@ void GalerkinDiscreteLagrangian::factorize_sparse_mass(const double* q) {
 
 void GalerkinDiscreteLagrangian::take_steps(double* q, double* p, double t0, double h, long steps, double* q1,
                                             double* p1) {
-  if (explicit_advance_ == nullptr) return DiscreteHamiltonianMap::take_steps(q, p, t0, h, steps, q1, p1);
-  (this->*explicit_advance_)(q, p, h, steps);
+  if (explicit_advance_ != nullptr) return (this->*explicit_advance_)(q, p, h, steps);
+  for (long k = 0; k < steps; ++k) {  // as DiscreteHamiltonianMap's, without a virtual call a step
+    t_ = t0 + static_cast<double>(k) * h;
+    (this->*step_)(q, p, h, q1, p1);
+    std::copy_n(q1, n_, q);
+    std::copy_n(p1, n_, p);
+  }
 }
 
 // q_i = q^0 + sum_nu l_nu(c_i) (q^nu - q^0) (sum_nu l_nu = 1), v_i = (1/h) sum_nu l'_nu(c_i) (q^nu - q^0),
@@ -528,7 +537,7 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
     S += h * b * L;
     if (order == Order::value) continue;
     for (int c = 0; c < n; ++c) impulse_[c] += (h * b) * grad_[c];
-    if (node_solve_ != nullptr) node_accelerations_.segment(j * n, n).noalias() = inverse_mass_ * grad_.head(n);
+    if (node_iteration_) node_accelerations_.segment(j * n, n).noalias() = inverse_mass_ * grad_.head(n);
     ++j;
     if (forced) add_forces(i, h, order);
     if (order == Order::hessian && sparse)
@@ -655,12 +664,12 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
 // or the 2R of the history.
 // Offsets from q0, numbers of size h |v|: q0 + offset rounds to eps |q0|, where forming the
 // positions themselves would add eps |q0| at every step (docs/hard-cases.md, Kepler).
-template <int N, int C>
+template <int N, int Rows, int C>
 [[gnu::always_inline]] inline void GalerkinDiscreteLagrangian::offsets_from_forces(const Eigen::MatrixXd& map, double h,
                                                                                   const double* __restrict accelerations,
                                                                                   double* __restrict offsets) const {
   const int n = fixed_or<N>(n_), nodes = fixed_or<C>(static_cast<int>(map.cols()) - 1),
-            rows = static_cast<int>(map.rows());
+            rows = fixed_or<Rows>(static_cast<int>(map.rows()));
   const double* __restrict W = map.data();
   const double* __restrict u0 = velocity0_.data();
   for (int j = 0; j < rows; ++j)
@@ -690,7 +699,6 @@ double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, dou
   const double* __restrict M_inverse = inverse_mass_.data();
   double* __restrict z = node_points_.data();
   double* __restrict gradients = node_gradients_.data();
-  double* __restrict forces = node_forces_.data();
   double* __restrict accelerations = node_accelerations_.data();
   double* __restrict next = next_offsets_.data();
   for (int j = 0; j < nodes; ++j)
@@ -699,13 +707,12 @@ double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, dou
   for (int j = 0; j < nodes; ++j) {
     const double* g = gradients + 2 * n * j;
     for (int c = 0; c < n; ++c) {
-      forces[j * n + c] = g[c];
       double a = 0.0;
       for (int d = 0; d < n; ++d) a += M_inverse[c + d * n] * g[d];
       accelerations[j * n + c] = a;
     }
   }
-  offsets_from_forces<N, R>(node_map_, h, accelerations, next);
+  offsets_from_forces<N, R, R>(node_map_, h, accelerations, next);
   double largest = 0.0;
   for (int j = 0; j < nodes; ++j)
     for (int c = 0; c < n; ++c) {
@@ -725,7 +732,7 @@ template <int N, int R>
 struct GalerkinDiscreteLagrangian::NodeIteration {
   GalerkinDiscreteLagrangian& g;
   double h, inverse_h;
-  double momentum;  // |p0|
+  double momentum, origin;  // |p0|, |q0|
 
   int size() const { return static_cast<int>(g.node_offsets_.size()); }
   bool simplified() const { return true; }
@@ -737,12 +744,11 @@ struct GalerkinDiscreteLagrangian::NodeIteration {
   }
   double apply(const Eigen::VectorXd&) {
     const int n = fixed_or<N>(g.n_), size = fixed_or<R>(static_cast<int>(g.iteration_nodes_.size())) * n;
-    double largest = 0.0, origin = 0.0;
+    double largest = 0.0;
     for (int k = 0; k < size; ++k) {
       g.node_offsets_[k] = g.next_offsets_[k];
       largest = std::max(largest, std::abs(g.node_offsets_[k]));
     }
-    for (int c = 0; c < n; ++c) origin = std::max(origin, std::abs(g.origin_[c]));
     return origin + largest;
   }
   void finish(const Eigen::VectorXd&) {}
@@ -756,27 +762,28 @@ struct GalerkinDiscreteLagrangian::NodeIteration {
 template <int N, int R>
 bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool continues) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
-  double momentum = 0.0;
+  double momentum = 0.0, origin = 0.0;
   for (int c = 0; c < n; ++c) {
     double u = 0.0;
     for (int d = 0; d < n; ++d) u += inverse_mass_.data()[c + d * n] * p0[d];
     velocity0_[c] = u;
     momentum = std::max(momentum, std::abs(p0[c]));
+    origin = std::max(origin, std::abs(origin_[c]));
   }
   if (continues) {
     constexpr int history = R == Eigen::Dynamic ? Eigen::Dynamic : 2 * R;
-    offsets_from_forces<N, history>(prediction_map_[two_steps_back_ ? 1 : 0], h, acceleration_history_.data(),
+    offsets_from_forces<N, R, history>(prediction_map_[two_steps_back_ ? 1 : 0], h, acceleration_history_.data(),
                                     node_offsets_.data());
   } else {  // the straight line with the velocity of the inverse Legendre transform, u0
     for (int j = 0; j < nodes; ++j)
       for (int c = 0; c < n; ++c) node_offsets_[j * n + c] = nodes_[iteration_nodes_[j]] * h * velocity0_[c];
   }
-  NodeIteration<N, R> iteration{*this, h, 1.0 / h, momentum};
+  NodeIteration<N, R> iteration{*this, h, 1.0 / h, momentum, origin};
   if (!solver_.solve(iteration, statistics_).converged()) return false;
-  offsets_from_forces<N, R>(end_map_, h, node_accelerations_.data(), points_.col(s_).data());
+  offsets_from_forces<N, 1, R>(end_map_, h, node_accelerations_.data(), points_.col(s_).data());
   for (int c = 0; c < n; ++c) {
     double sum = 0.0;
-    for (int j = 0; j < nodes; ++j) sum += weights_[iteration_nodes_[j]] * node_forces_.data()[j * n + c];
+    for (int j = 0; j < nodes; ++j) sum += weights_[iteration_nodes_[j]] * node_gradients_[2 * n * j + c];
     impulse_[c] = h * sum;
   }
   return true;
@@ -895,9 +902,9 @@ void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unkno
 // the velocity of the inverse Legendre transform. Offsets from q0 = the last step's q1:
 // q(1 + d_nu) - q1 = sum_mu l_mu(1 + d_nu) (q_prev^mu - q_prev^0) - (q_prev^s - q_prev^0).
 void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, double h, bool continues) {
-  if (continues && node_solve_ != nullptr) {
+  if (continues && node_iteration_) {
     predict_accelerations();
-    offsets_from_forces<Eigen::Dynamic, Eigen::Dynamic>(control_map_, h, predicted_accelerations_.data(),
+    offsets_from_forces<Eigen::Dynamic, Eigen::Dynamic, Eigen::Dynamic>(control_map_, h, predicted_accelerations_.data(),
                                                         points_.col(1).data());
   } else if (continues) {
     points_.noalias() = previous_ * extrapolation_;
@@ -909,12 +916,6 @@ void GalerkinDiscreteLagrangian::warm_start(const double* q0, const double* p0, 
   points_.col(0).setZero();
 }
 
-// q1 = q0 + (q^s - q^0), and p1 = D2 L_d + f_d^s written as p0 plus its change: the equations
-// sum to sum_nu (dS/dq^nu + f_d^nu) = impulse_ (see action()), so
-//   p1 - p0 = impulse_ - (dS/dq^0 + f_d^0 + p0) - sum_{0 < nu < s} (dS/dq^nu + f_d^nu),
-// the impulse less the residuals of the solved equations (formed by the solve's finish(), where the
-// residuals are at hand). Both sums are compensated across steps (compensated.hpp) when a step
-// continues from the last one's output.
 void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, double t0, double h, double* q1,
                                            double* p1) {
   if (explicit_advance_ != nullptr) {
@@ -922,30 +923,54 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
     std::copy_n(p0, n_, p1);
     return (this->*explicit_advance_)(q1, p1, h, 1);
   }
-  const Eigen::Map<const Eigen::VectorXd> start(q0, n_), momentum(p0, n_);
-  if (!(has_previous_ && previous_end_ == start && end_p_ == momentum)) {
-    carry_q_.setZero();
-    carry_p_.setZero();
-  }
   t_ = t0;
-  const bool continues = has_previous_ && previous_h_ == h && previous_end_ == start;
-  origin_ = start;
+  (this->*step_)(q0, p0, h, q1, p1);
+}
+
+// q1 = q0 + (q^s - q^0), and p1 = D2 L_d + f_d^s written as p0 plus its change: the equations
+// sum to sum_nu (dS/dq^nu + f_d^nu) = impulse_ (see action()), so
+//   p1 - p0 = impulse_ - (dS/dq^0 + f_d^0 + p0) - sum_{0 < nu < s} (dS/dq^nu + f_d^nu),
+// the impulse less the residuals of the solved equations (formed by the solve's finish(), where the
+// residuals are at hand). Both sums are compensated across steps (compensated.hpp) when a step
+// continues from the last one's output.
+// At N = n and R nodes of the node iteration where both are small (for_shape), in
+// loops of a fixed length: at n = 1 the same step through dynamic-size Eigen expressions took
+// 340 instructions of bookkeeping besides the solve.
+template <int N, int R>
+void GalerkinDiscreteLagrangian::step_at(const double* q0, const double* p0, double h, double* q1, double* p1) {
+  using Vector = Eigen::Matrix<double, N, 1>;
+  const int n = fixed_or<N>(n_);
+  bool same_point = has_previous_, same_momentum = has_previous_;
+  for (int c = 0; c < n; ++c) {
+    same_point = same_point && previous_end_[c] == q0[c];
+    same_momentum = same_momentum && end_p_[c] == p0[c];
+    origin_[c] = q0[c];
+  }
+  Eigen::Map<Vector> carry_q(carry_q_.data(), n), carry_p(carry_p_.data(), n);
+  if (!(same_point && same_momentum)) {
+    carry_q.setZero();
+    carry_p.setZero();
+  }
+  const bool continues = same_point && previous_h_ == h;
   // impulse_ is then p1 - p0, q^s - q^0 that of q1 (solve_at_nodes, or the Equations' finish())
-  if (node_solve_ == nullptr || !(this->*node_solve_)(p0, h, continues)) {
+  if (!(node_iteration_ && solve_at_nodes<N, R>(p0, h, continues))) {
     warm_start(q0, p0, h, continues);
     newton(h, 1, 0, s_, p0, !forces_.empty());
   }
-  Eigen::Map<Eigen::VectorXd> end(q1, n_), momentum1(p1, n_);
-  previous_end_ = start;
-  compensated_add(previous_end_, points_.col(s_), carry_q_);
-  end_p_ = momentum;
-  compensated_add(end_p_, impulse_, carry_p_);
-  end = previous_end_;
-  momentum1 = end_p_;
-  if (node_solve_ != nullptr) {  // the history shifts by a step
-    const Eigen::Index r = node_forces_.cols();
-    acceleration_history_.rightCols(r) = acceleration_history_.leftCols(r);
-    acceleration_history_.leftCols(r) = node_accelerations_.reshaped(n_, r);
+  Eigen::Map<Vector> end(previous_end_.data(), n), momentum(end_p_.data(), n);
+  end = Eigen::Map<const Vector>(q0, n);
+  compensated_add(end, Eigen::Map<const Vector>(points_.col(s_).data(), n), carry_q);
+  momentum = Eigen::Map<const Vector>(p0, n);
+  compensated_add(momentum, Eigen::Map<const Vector>(impulse_.data(), n), carry_p);
+  Eigen::Map<Vector>(q1, n) = end;
+  Eigen::Map<Vector>(p1, n) = momentum;
+  if (node_iteration_) {  // the history shifts by a step
+    const int size = n * fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
+    double* __restrict history = acceleration_history_.data();
+    for (int k = 0; k < size; ++k) {
+      history[size + k] = history[k];
+      history[k] = node_accelerations_[k];
+    }
     two_steps_back_ = continues;
   } else
     previous_ = points_;

@@ -126,7 +126,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // it converged; else the step is solved again with the exact Jacobian, from warm_start()), and
   // the linear map from the forces at the nodes to offsets. Compiled for N = n <= 4 and R = the
   // nodes of nonzero weight <= 7 where both are small (loops of a fixed length), Eigen::Dynamic
-  // otherwise, chosen once (node_solve_).
+  // otherwise, chosen once (step_).
   bool simplified_applies();
   Eigen::MatrixXd extrapolation_to_nodes(const std::vector<double>& times) const;
   template <int N, int R>
@@ -136,9 +136,12 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N, int R>
   bool solve_at_nodes(const double* p0, double h, bool continues);
   void predict_accelerations();
-  template <int N, int C>
+  template <int N, int Rows, int C>
   void offsets_from_forces(const Eigen::MatrixXd& map, double h, const double* forces, double* offsets) const;
-  using NodeSolveFunction = bool (GalerkinDiscreteLagrangian::*)(const double*, double, bool);
+  // take_step() from the step's start (t_ set), at fixed sizes (step_at: see the .cpp).
+  template <int N, int R>
+  void step_at(const double* q0, const double* p0, double h, double* q1, double* p1);
+  using StepFunction = void (GalerkinDiscreteLagrangian::*)(const double*, const double*, double, double*, double*);
   void factorize_sparse();
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
@@ -213,13 +216,14 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // and, at the last (q1, p1) with step previous_h_, dL/dq and the increment h v (reused by a step
   // from there: one gradient evaluation per step).
   AdvanceFunction explicit_advance_ = nullptr;
+  StepFunction step_ = nullptr;  // every other step: step_at<N, R>, chosen once
   // Simplified Newton in the nodes' coordinates (constant mass matrix). M^{-1} (inverse_mass_);
   // the velocity u0 = M^{-1} p0 of the step; the maps from (u0, the forces' M^{-1} g_i) to offsets
   // (see offsets_from_forces): to the nodes' (node_map_, R x (1 + R)) and to the control points'
   // q^1..q^s (control_map_, s x (1 + R); end_map_ its last row, q1's); the indices of the nodes of
   // nonzero weight (the iteration's nodes, R of them) in the quadrature; their offsets from q0 at
   // the current iterate and at the next (node_offsets_, next_offsets_, R n), their forces g_i =
-  // dL/dq and M^{-1} g_i at the last evaluation (node_forces_, node_accelerations_) and M^{-1} g_i
+  // dL/dq and M^{-1} g_i at the last evaluation (in node_gradients_, node_accelerations_) and M^{-1} g_i
   // as predicted from the last steps (predicted_accelerations_, for the exact Jacobian's start);
   // the batch of (q, v) points handed to the plugin (v = 0) and its gradients [L_q, L_v] (2 n R
   // each). The warm start: the accelerations M^{-1} dL/dq at the nodes of the last two steps
@@ -229,13 +233,13 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // (k = 1), and the nodes' offsets they give, prediction_map_[k] (R x (1 + 2R): node_map_'s
   // column of u0, then its forces' columns times E_k^T); two_steps_back_ says whether the step
   // before the last is in the history (the last continued it with the same h).
-  NodeSolveFunction node_solve_ = nullptr;
+  bool node_iteration_ = false;
   Eigen::MatrixXd node_map_, control_map_, end_map_, prediction_map_[2];
   double mass_norm_ = 0.0;  // |M|_inf
   std::vector<int> iteration_nodes_;
   Eigen::VectorXd velocity0_, node_offsets_, next_offsets_, node_accelerations_, predicted_accelerations_;
   Eigen::VectorXd node_points_, node_gradients_;
-  Eigen::MatrixXd node_forces_, acceleration_history_, force_extrapolation_[2];  // n x R, n x 2R, 2R x R
+  Eigen::MatrixXd acceleration_history_, force_extrapolation_[2];  // n x 2R, 2R x R
   bool two_steps_back_ = false;
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;

@@ -173,7 +173,7 @@ class NewtonSolver {
  public:
   static constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
   static constexpr double kBrouwer = 1e-3;  // simplified Newton's residual left, in eps (above)
-  explicit NewtonSolver(SolverOptions options = {}) : options_(options) {
+  explicit NewtonSolver(SolverOptions options = {}) : options_(options), root_tolerance_(std::sqrt(options.tolerance)) {
     residuals_.reserve(options_.max_iterations + 1);
   }
   const SolverOptions& options() const { return options_; }
@@ -218,10 +218,11 @@ class NewtonSolver {
       // O(last update x this update).
       if (k == 0 || (!at_round_off && !simplified)) system.factorize();
       system.solve(F_, update_);
-      const double size_of_update = max_norm(update_);
+      // |update| enters simplified Newton's rule only where the residual stopped decreasing.
+      const double size_of_update = simplified && decreasing ? 0.0 : max_norm(update_);
       const double x_yardstick = system.apply(update_);
       report.iterations = k + 1;
-      const bool stagnating = !decreasing && size_of_update <= std::sqrt(options_.tolerance) * (1.0 + x_yardstick);
+      const bool stagnating = !decreasing && size_of_update <= root_tolerance_ * (1.0 + x_yardstick);
       const bool converged =
           simplified ? (stagnating && options_.converged(std::min(r, residuals_[k - 1]), yardstick)) ||
                            (contraction < 0.5 && (options_.converged(r, yardstick) || contraction * r <= left * kEpsilon * (1.0 + yardstick)))
@@ -247,6 +248,7 @@ class NewtonSolver {
 
  private:
   SolverOptions options_;
+  double root_tolerance_;  // sqrt(tolerance), the stagnation's bound on the update
   Eigen::VectorXd F_, update_;
   std::vector<double> residuals_;
 };
