@@ -691,7 +691,8 @@ template <int N, int Rows, int C>
 // rule stopped with systematic errors h^-1 times larger, and the s = 6 Gauss steps of the
 // pendulum ended 1.6e-13 from gni_irk2's instead of 2e-15.)
 template <int N, int R>
-double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, double momentum, double* __restrict F) {
+[[gnu::always_inline]] inline double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, double momentum,
+                                                                               double* __restrict F) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
   const double* __restrict q0 = origin_.data();
   const double* __restrict D = node_offsets_.data();

@@ -90,12 +90,6 @@ void LagrangianEvaluator::gradient_jet(const Jet2* q, const Jet2* v, Jet2* value
     throw NumericalFailure("the Lagrangian's gradient at jets is not finite", std::nan(""), lagrangian_.origin());
 }
 
-void LagrangianEvaluator::gradients(int count, const double* points, double* gradients) {
-  check(lagrangian_, lagrangian_.gradients(count, points, gradients), "Lagrangian gradients");
-  counters_.gradient += count;
-  check_finite(gradients, count * (m_ + n_), "gradient");
-}
-
 bool LagrangianEvaluator::verlet_steps(double* q, double* d, double* f, const double* K, long steps) {
   check(lagrangian_, lagrangian_.verlet_steps(q, d, f, K, steps), "Lagrangian Stormer-Verlet steps");
   counters_.gradient += steps;

@@ -27,8 +27,13 @@ class LagrangianEvaluator {
   // gradient: m + n numbers [dL/dq, dL/dv]; the plugin is not asked for L.
   void gradient(const double* q, const double* v, double* gradient) { evaluate_gradient(q, v, nullptr, gradient); }
   // The gradients at `count` points z_i = (q, v) (m + n numbers each) in one plugin call
-  // (Lagrangian::gradients), each counted and checked as gradient() does.
-  void gradients(int count, const double* points, double* gradients);
+  // (Lagrangian::gradients), each counted and checked as gradient() does. Inline: the node
+  // iteration calls it at every pass (issue #19).
+  void gradients(int count, const double* points, double* gradients) {
+    check(lagrangian_, lagrangian_.gradients(count, points, gradients), "Lagrangian gradients");
+    counters_.gradient += count;
+    check_finite(gradients, count * (m_ + n_), "gradient");
+  }
   // L, and its gradient as above.
   double value_and_gradient(const double* q, const double* v, double* gradient);
   // hessian: (m+n)^2 numbers, dense column-major (sparse Lagrangians are expanded).
@@ -68,9 +73,12 @@ class LagrangianEvaluator {
   // Inline, with the message built out of line: the explicit Stormer-Verlet loop makes one such
   // evaluation per step (the plugin has just stored these numbers one by one: a vectorized check
   // would wait on each load for the stores to be forwarded).
+  // x * 0 is 0 for a finite x and NaN otherwise: one branch for all the values (the batches of
+  // Lagrangian::gradients are checked at every pass of the node iteration).
   void check_finite(const double* values, int count, const char* what) const {
-    for (int i = 0; i < count; ++i)
-      if (!std::isfinite(values[i])) not_finite(what);
+    double zero = 0.0;
+    for (int i = 0; i < count; ++i) zero += values[i] * 0.0;
+    if (!(zero == 0.0)) not_finite(what);
   }
   [[noreturn]] void not_finite(const char* what) const;
   double unchecked_value(const double* q, const double* v);
