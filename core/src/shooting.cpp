@@ -136,8 +136,10 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   momentum_change_.resize(n_);
   carry_q_ = Eigen::VectorXd::Zero(n_);
   carry_p_ = Eigen::VectorXd::Zero(n_);
-  end_q_.resize(n_);
+  end_q_.resize(m_);
   end_p_.resize(n_);
+  guess_.resize(n_);
+  corrections_history_.resize(n_, kCorrections);
   origin_.resize(n_);
   if (mechanical_ != nullptr) mechanical_->set_origin(origin_.data());
   Bq_.resize(n_, n_);
@@ -477,7 +479,8 @@ void ShootingDiscreteLagrangian::solve(const double* q0, double h, Target target
 }
 
 // The paper's shooting-based implementation: w0 = v0 from the inverse Legendre transform
-// v0 = M^{-1} p0 (Lagrangian form), or w0 = p^0 guessed as p0 (Hamiltonian forms).
+// v0 = M^{-1} p0 (Lagrangian form), or w0 = p^0 guessed as p0 (Hamiltonian forms), corrected by
+// the extrapolated corrections of the last steps (warm_start).
 // On a vector space in a Type I form, q1 = q0 + (q^n - q0) and p1 = p0 + (D1 L_d + D2 L_d) - r
 // (r = p0 + D1 L_d, the residual left; with forces D1 and D2 include f_d^-, f_d^+), the
 // increments summed with Kahan's compensation across steps (compensated.hpp) while each step
@@ -486,18 +489,21 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
                                       double* p1) {
   forced_ = !forces_.empty();
   t_ = t0;
-  if (form_ == ShootingForm::lagrangian && field_->constant_mass()) field_->inverse_mass(p0, w_.data());
-  else if (form_ == ShootingForm::lagrangian) mechanical_->velocity_of(q0, p0, w_.data());
-  else w_ = Eigen::Map<const Eigen::VectorXd>(p0, n_);
+  const Eigen::Map<const Eigen::VectorXd> start(q0, m_), momentum(p0, n_);
+  const bool continues = continuing_ && end_q_ == start && end_p_ == momentum;
+  if (form_ == ShootingForm::lagrangian && field_->constant_mass()) field_->inverse_mass(p0, guess_.data());
+  else if (form_ == ShootingForm::lagrangian) mechanical_->velocity_of(q0, p0, guess_.data());
+  else guess_ = momentum;
+  warm_start(continues && h == previous_h_);
   target_is_end_ = true;
   solve(q0, h, Target::momentum, p0);
+  record_correction(h);
   Eigen::Map<Eigen::VectorXd> p(p1, n_);
   if (type_2()) {
     for (int r = 0; r < n_; ++r) p[r] = boundary_[r].value;
     Eigen::Map<Eigen::VectorXd>(q1, n_) = lambda_;
   } else if (offsets()) {
-    const Eigen::Map<const Eigen::VectorXd> start(q0, n_), momentum(p0, n_);
-    if (!(continuing_ && end_q_ == start && end_p_ == momentum)) {
+    if (!continues) {
       carry_q_.setZero();
       carry_p_.setZero();
     }
@@ -509,11 +515,38 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
     compensated_add(end_p_, momentum_change_, carry_p_);
     Eigen::Map<Eigen::VectorXd>(q1, n_) = end_q_;
     p = end_p_;
-    continuing_ = true;
   } else {
     for (int r = 0; r < m_; ++r) q1[r] = state_[r].value;
     p = lambda_;  // with forces p1 = D2 L_d + f_d^+
   }
+  end_q_ = Eigen::Map<const Eigen::VectorXd>(q1, m_);
+  end_p_ = p;
+  continuing_ = true;
+}
+
+// The warm start: w0 = guess + c, the correction c = w0 - guess of the step extrapolated from the
+// last steps' (while the steps continue one another at the same h) by the polynomial through up to
+// three of them. The correction is a smooth function of the state along the motion, of the
+// size of the method's local error (the inverse Legendre transform is exact for the exact flow),
+// so that the first shot's residual is of that size times h^k, k the corrections used. With the
+// guess alone the first residual of the pendulum at h = 0.005 (SVIRK4) was 1e-12 and every step
+// took two shots; from the extrapolation the first update is at round-off and the step one shot
+// (Newton's stopping rule, solve/newton.hpp: the error left is of the update's square).
+void ShootingDiscreteLagrangian::warm_start(bool continues) {
+  if (!continues) corrections_ = 0;
+  static constexpr double kExtrapolation[3][3] = {{1.0, 0.0, 0.0}, {2.0, -1.0, 0.0}, {3.0, -3.0, 1.0}};
+  w_ = guess_;
+  if (corrections_ == 0) return;
+  const double* c = kExtrapolation[corrections_ - 1];
+  for (int k = 0; k < corrections_; ++k) w_ += c[k] * corrections_history_.col(k);
+}
+
+// The converged step's correction w0 - guess joins the history (newest first).
+void ShootingDiscreteLagrangian::record_correction(double h) {
+  for (int k = kCorrections - 1; k > 0; --k) corrections_history_.col(k) = corrections_history_.col(k - 1);
+  corrections_history_.col(0) = w_ - guess_;
+  corrections_ = std::min(corrections_ + 1, kCorrections);
+  previous_h_ = h;
 }
 
 const EvaluationCounters& ShootingDiscreteLagrangian::evaluations() const {

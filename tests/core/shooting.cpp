@@ -254,6 +254,37 @@ TEST_CASE("the shooting Newton iteration converges quadratically from the invers
   CHECK(statistics.mean() <= 3.0);
 }
 
+TEST_CASE("steps that continue one another start from the extrapolated corrections: one shot each, the cold steps' result") {
+  SeparablePendulum pendulum;
+  auto rule = simpson();
+  auto method = rk4();
+  FlatSpace space(1);
+  const double h = 0.005;
+  ShootingDiscreteLagrangian warm(space, pendulum, rule, method, ShootingForm::lagrangian, {});
+  double q = 1.3, p = 0.0, q1, p1;
+  for (int k = 0; k < 200; ++k) {
+    // The same step from the inverse Legendre guess alone, by a construction that has taken none.
+    ShootingDiscreteLagrangian cold(space, pendulum, rule, method, ShootingForm::lagrangian, {});
+    double cold_q1, cold_p1;
+    cold.step(&q, &p, h, &cold_q1, &cold_p1);
+    warm.step(&q, &p, h, &q1, &p1);
+    CAPTURE(k);
+    CHECK(cold.solver_statistics().iterations == 2);  // the guess is off by ~1e-12 here
+    CHECK(std::abs(q1 - cold_q1) <= 4e-16);
+    CHECK(std::abs(p1 - cold_p1) <= 4e-16);
+    q = q1;
+    p = p1;
+  }
+  // From the fourth step on (three corrections known), every step ends after its first shot.
+  CAPTURE(warm.solver_statistics().mean());
+  CHECK(warm.solver_statistics().iterations <= 2 * 3 + (200 - 3));
+  CHECK(warm.solver_statistics().max_iterations == 2);
+  // A step that does not continue the last (another point) starts from the guess again.
+  double other_q = 0.4, other_p = 0.1;
+  warm.step(&other_q, &other_p, h, &q1, &p1);
+  CHECK(warm.last_residuals().size() == 2);
+}
+
 TEST_CASE("implicit stage solves converge quadratically and are counted") {
   SeparablePendulum pendulum;
   auto rule = trapezoid();

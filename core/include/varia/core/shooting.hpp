@@ -3,7 +3,8 @@
 //   q^0 = q0, q^n = q1,
 // from a one-step method Psi (order p) and a quadrature rule (order q): order min(p, q). Its
 // discrete Hamiltonian map is the paper's shooting-based implementation ("Implementation
-// issues"): from q^0 = q0 and a guess of v^0 (the inverse Legendre transform of p0), propagate,
+// issues"): from q^0 = q0 and a guess of v^0 (the inverse Legendre transform of p0, corrected by
+// the last steps' corrections extrapolated while the steps continue one another), propagate,
 // and iterate on v^0 by Newton's method until p0 = -D1 L_d(q0, q^n); then q1 = q^n and
 // p1 = D2 L_d.
 //
@@ -146,6 +147,8 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void residual(Target target, const double* data);
   struct Equations;  // the shooting equations as a NewtonSolver system
   void solve(const double* q0, double h, Target target, const double* data);
+  void warm_start(bool continues);
+  void record_correction(double h);
   bool type_2() const { return form_ == ShootingForm::type_2; }
   // The boundary quantity is the offset q^n - (q0 + eta): a vector space, Type I forms.
   bool offsets() const { return mechanical_ != nullptr && !type_2(); }
@@ -188,9 +191,17 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::MatrixXd Bq_, Bw_, phi_, jacobian_;
   Eigen::MatrixXd lambda_jacobian_;  // dlambda/dw0 = B_w^{-T} Phi_ww
   // Compensated sums q1 = q0 + (q^n - q0), p1 = p0 + (p1 - p0) across steps (compensated.hpp):
-  // the increments, the running compensations, and the last output with whether it is one.
+  // the increments and the running compensations; the last step's output, whether there is one,
+  // and its h.
   Eigen::VectorXd offset_, momentum_change_, carry_q_, carry_p_, end_q_, end_p_;
   bool continuing_ = false;
+  double previous_h_ = 0.0;
+  // The warm start (warm_start()): the inverse Legendre transform's guess of w0, and the
+  // corrections w0 - guess of the last steps, newest first (corrections_ of them).
+  static constexpr int kCorrections = 3;
+  Eigen::VectorXd guess_;
+  Eigen::MatrixXd corrections_history_;
+  int corrections_ = 0;
   Eigen::PartialPivLU<Eigen::MatrixXd> BwT_lu_, jacobian_lu_;  // of B_w^T and the Jacobian
 };
 
