@@ -300,12 +300,12 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
     const bool repeated = std::any_of(last.begin(), last.end(), [&](double u) { return std::abs(u - t) < 1e-12; });
     if (!repeated) two_back[R + j] = t, ++taken;
   }
-  force_extrapolation_[0] = extrapolation_to_nodes(last);
-  force_extrapolation_[1] = extrapolation_to_nodes(two_back);
+  acceleration_extrapolation_[0] = extrapolation_to_nodes(last);
+  acceleration_extrapolation_[1] = extrapolation_to_nodes(two_back);
   for (int k = 0; k < 2; ++k) {  // the nodes' offsets from the history: [u0's | W E_k^T]
     prediction_map_[k].resize(R, 1 + 2 * R);
     prediction_map_[k].col(0) = node_map_.col(0);
-    prediction_map_[k].rightCols(2 * R).noalias() = node_map_.rightCols(R) * force_extrapolation_[k].transpose();
+    prediction_map_[k].rightCols(2 * R).noalias() = node_map_.rightCols(R) * acceleration_extrapolation_[k].transpose();
   }
   return true;
 }
@@ -457,12 +457,12 @@ void GalerkinDiscreteLagrangian::factorize_sparse_mass(const double* q) {
 void GalerkinDiscreteLagrangian::take_steps(double* q, double* p, double t0, double h, long steps, double* q1,
                                             double* p1) {
   if (explicit_advance_ != nullptr) return (this->*explicit_advance_)(q, p, h, steps);
-  for (long k = 0; k < steps; ++k) {  // as DiscreteHamiltonianMap's, without a virtual call a step
-    t_ = t0 + static_cast<double>(k) * h;
-    (this->*step_)(q, p, h, q1, p1);
-    std::copy_n(q1, n_, q);
-    std::copy_n(p1, n_, p);
-  }
+  repeat_steps(  // by step_, without a virtual call a step
+      [this](const double* q0, const double* p0, double t, double step, double* q_end, double* p_end) {
+        t_ = t;
+        (this->*step_)(q0, p0, step, q_end, p_end);
+      },
+      q, p, t0, h, steps, q1, p1);
 }
 
 // q_i = q^0 + sum_nu l_nu(c_i) (q^nu - q^0) (sum_nu l_nu = 1), v_i = (1/h) sum_nu l'_nu(c_i) (q^nu - q^0),
@@ -800,7 +800,7 @@ bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool
 // node_map_ in one); this, for the exact Jacobian's start where the iteration did not converge,
 // forms the predicted accelerations at the nodes themselves, into predicted_accelerations_.
 void GalerkinDiscreteLagrangian::predict_accelerations() {
-  const Eigen::MatrixXd& E = force_extrapolation_[two_steps_back_ ? 1 : 0];
+  const Eigen::MatrixXd& E = acceleration_extrapolation_[two_steps_back_ ? 1 : 0];
   const int n = n_, R = static_cast<int>(E.cols());
   for (int j = 0; j < R; ++j)
     for (int c = 0; c < n; ++c) {

@@ -56,10 +56,17 @@ class DiscreteHamiltonianMap {
   // round-off accumulates in the time). A map may override it to keep its state in registers
   // across steps (the explicit Galerkin form does).
   virtual void take_steps(double* q, double* p, double t0, double h, long steps, double* q1, double* p1) {
+    repeat_steps([this](auto... step) { take_step(step...); }, q, p, t0, h, steps, q1, p1);
+  }
+  // The loop of take_steps() by `step` (take_step's arguments): a map that overrides take_steps
+  // to step by a non-virtual function passes it here.
+  template <class Step>
+  void repeat_steps(Step&& step, double* q, double* p, double t0, double h, long steps, double* q1, double* p1) {
+    const int m = point_size(), n = dim();
     for (long k = 0; k < steps; ++k) {
-      take_step(q, p, t0 + static_cast<double>(k) * h, h, q1, p1);
-      std::copy_n(q1, point_size(), q);
-      std::copy_n(p1, dim(), p);
+      step(q, p, t0 + static_cast<double>(k) * h, h, q1, p1);
+      std::copy_n(q1, m, q);
+      std::copy_n(p1, n, p);
     }
   }
 };

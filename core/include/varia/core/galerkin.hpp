@@ -228,7 +228,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // the batch of (q, v) points handed to the plugin (v = 0) and its gradients [L_q, L_v] (2 n R
   // each). The warm start: the accelerations M^{-1} dL/dq at the nodes of the last two steps
   // (acceleration_history_, n x 2R: the last step's, then the one's before), extrapolated to the
-  // next step's nodes by force_extrapolation_[k] (2R x R): the Lagrange basis through the last
+  // next step's nodes by acceleration_extrapolation_[k] (2R x R): the Lagrange basis through the last
   // step's nodes (k = 0), or through those and the two latest distinct nodes of the step before
   // (k = 1), and the nodes' offsets they give, prediction_map_[k] (R x (1 + 2R): node_map_'s
   // column of u0, then its forces' columns times E_k^T); two_steps_back_ says whether the step
@@ -239,7 +239,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   std::vector<int> iteration_nodes_;
   Eigen::VectorXd velocity0_, node_offsets_, next_offsets_, node_accelerations_, predicted_accelerations_;
   Eigen::VectorXd node_points_, node_gradients_;
-  Eigen::MatrixXd acceleration_history_, force_extrapolation_[2];  // n x 2R, 2R x R
+  Eigen::MatrixXd acceleration_history_, acceleration_extrapolation_[2];  // n x 2R, 2R x R
   bool two_steps_back_ = false;
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;

@@ -70,11 +70,10 @@ class LagrangianEvaluator {
   double energy(const double* q, const double* v, const double* p);
 
  private:
-  // Inline, with the message built out of line: the explicit Stormer-Verlet loop makes one such
-  // evaluation per step (the plugin has just stored these numbers one by one: a vectorized check
-  // would wait on each load for the stores to be forwarded).
-  // x * 0 is 0 for a finite x and NaN otherwise: one branch for all the values (the batches of
-  // Lagrangian::gradients are checked at every pass of the node iteration).
+  // Whether every value is finite, by x * 0 (0 for a finite x, NaN otherwise) summed: one branch
+  // for all the values, at every pass of the node iteration and every explicit Stormer-Verlet
+  // step. Inline, with the message built out of line; scalar loads, because the plugin has just
+  // stored these numbers one by one and a vectorized load would wait for the stores to be forwarded.
   void check_finite(const double* values, int count, const char* what) const {
     double zero = 0.0;
     for (int i = 0; i < count; ++i) zero += values[i] * 0.0;
