@@ -261,7 +261,8 @@ class AutodiffLagrangian : public Lagrangian {
   // A shooting pass's jets have up to twice the manifold's dimension in variables (shooting.hpp).
   template <int N>
   void at_fixed_jets(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) const {
-    std::array<FixedJet<N>, kStackVariables> inputs, outputs;
+    std::array<FixedJet<N>, kStackVariables> inputs, outputs;  // FixedJet's are uninitialized (jet.hpp)
+    inputs.fill(FixedJet<N>(0.0));  // the model reads only m + n of them, but the compiler cannot see that
     FixedJet<N> fixed_value;
     for (int i = 0; i < m_ + n_; ++i) inputs[i] = FixedJet<N>(at(q, v, m_, i));
     at_jets(inputs.data(), inputs.data() + m_, value != nullptr ? &fixed_value : nullptr, outputs.data());
