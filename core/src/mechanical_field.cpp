@@ -78,10 +78,9 @@ namespace {
 // y = A x, A of doubles, x and y (distinct) of jets; A's zero entries are skipped.
 void multiply(const Eigen::MatrixXd& A, const Jet2* x, Jet2* y) {
   for (Eigen::Index r = 0; r < A.rows(); ++r) {
-    Jet2 sum;
+    y[r] = Jet2(0.0);
     for (Eigen::Index c = 0; c < A.cols(); ++c)
-      if (A(r, c) != 0.0) sum += A(r, c) * x[c];
-    y[r] = sum;
+      if (A(r, c) != 0.0) add_scaled(y[r], A(r, c), x[c]);
   }
 }
 
@@ -139,7 +138,7 @@ const double* MechanicalField::point(const double* y) {
 
 const Jet2* MechanicalField::point(const Jet2* y) {
   if (origin_ == nullptr) return y;
-  for (int r = 0; r < n_; ++r) absolute_jet_[r] = origin_[r] + y[r];
+  for (int r = 0; r < n_; ++r) add_scaled(absolute_jet_[r] = origin_[r], 1.0, y[r]);
   return absolute_jet_.data();
 }
 

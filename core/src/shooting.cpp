@@ -215,13 +215,13 @@ void ShootingDiscreteLagrangian::accumulate(int node, double h, Jet2& S) {
   else std::copy_n(state_.begin() + m_, n_, v_.begin());
   Jet2 L;
   lagrangian_.gradient_jet(position(), v_.data(), &L, gradient_.data());
-  S += (h * weights_[node]) * L;
+  add_scaled(S, h * weights_[node], L);
   if (forced_) add_work(h * weights_[node]);
   if (correction == 0.0) return;
   field_->inverse_mass(gradient_.data(), acceleration_.data());
   Jet2 rate;
   for (int r = 0; r < n_; ++r) rate += gradient_[r] * v_[r] + gradient_[n_ + r] * acceleration_[r];
-  S += (h * h * correction) * rate;
+  add_scaled(S, h * h * correction, rate);
 }
 
 // The virtual work of the forces at node i, weight = h b_i: W_x += weight q^i_x^T f_i and
@@ -499,10 +499,7 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   solve(q0, h, Target::momentum, p0);
   record_correction(h);
   Eigen::Map<Eigen::VectorXd> p(p1, n_);
-  if (type_2()) {
-    for (int r = 0; r < n_; ++r) p[r] = boundary_[r].value;
-    Eigen::Map<Eigen::VectorXd>(q1, n_) = lambda_;
-  } else if (offsets()) {
+  if (offsets()) {
     if (!continues) {
       carry_q_.setZero();
       carry_p_.setZero();
@@ -516,11 +513,16 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
     Eigen::Map<Eigen::VectorXd>(q1, n_) = end_q_;
     p = end_p_;
   } else {
-    for (int r = 0; r < m_; ++r) q1[r] = state_[r].value;
-    p = lambda_;  // with forces p1 = D2 L_d + f_d^+
+    if (type_2()) {
+      for (int r = 0; r < n_; ++r) p[r] = boundary_[r].value;
+      Eigen::Map<Eigen::VectorXd>(q1, n_) = lambda_;
+    } else {
+      for (int r = 0; r < m_; ++r) q1[r] = state_[r].value;
+      p = lambda_;  // with forces p1 = D2 L_d + f_d^+
+    }
+    end_q_ = Eigen::Map<const Eigen::VectorXd>(q1, m_);
+    end_p_ = p;
   }
-  end_q_ = Eigen::Map<const Eigen::VectorXd>(q1, m_);
-  end_p_ = p;
   continuing_ = true;
 }
 

@@ -56,7 +56,7 @@ class DiscreteHamiltonianMap {
   // round-off accumulates in the time). A map may override it to keep its state in registers
   // across steps (the explicit Galerkin form does).
   virtual void take_steps(double* q, double* p, double t0, double h, long steps, double* q1, double* p1) {
-    repeat_steps([this](auto... step) { take_step(step...); }, q, p, t0, h, steps, q1, p1);
+    repeat_steps([this](auto... args) { take_step(args...); }, q, p, t0, h, steps, q1, p1);
   }
   // The loop of take_steps() by `step` (take_step's arguments): a map that overrides take_steps
   // to step by a non-virtual function passes it here.

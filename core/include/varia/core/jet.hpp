@@ -24,6 +24,9 @@ namespace varia {
 
 inline constexpr int kMaxJetVariables = 12;
 
+template <int N>
+struct FixedJet;
+
 namespace jet {
 
 // f(a), given f(a.value) and f', f'' there: g = f' a_g, H = f' a_H + f'' a_g a_g^T.
@@ -88,6 +91,37 @@ J binary(const J& a, const J& b, double f, const Partials& d) {
   for (int j = 0; j < n; ++j)
     for (int i = 0; i < n; ++i)
       rH[j * n + i] = d.a * Ha[j * n + i] + d.b * Hb[j * n + i] + u[i] * ga[j] + w[i] * gb[j];
+  return r;
+}
+
+// The same chain rule at a fixed number N of variables, inlined into each operation: there the
+// sizes are constants and a jet is never constant, so that it is a few fixed-size vector
+// operations, and where the partials are constants (a sum's 1, 1, 0, 0, 0) the terms they zero
+// go. The terms are those of the loops above, summed in the same order, so that both give the
+// same numbers; the zero ones are skipped as there (0 * an infinite gradient would make NaN). A SVIRK4
+// step of the pendulum, whose model the SDK evaluates at dual numbers over FixedJet<2>: 4.57 ->
+// 3.80 us; the loops above, inlined instead, made it slower (4.68 us).
+template <int N>
+[[gnu::always_inline]] inline FixedJet<N> unary(const FixedJet<N>& a, double f, double d1, double d2) {
+  FixedJet<N> r;
+  r.value = f;
+  r.gradient = d1 * a.gradient;
+  r.hessian = d1 * a.hessian;
+  if (d2 != 0.0) r.hessian.noalias() += a.gradient * (d2 * a.gradient).transpose();
+  return r;
+}
+template <int N>
+[[gnu::always_inline]] inline FixedJet<N> binary(const FixedJet<N>& a, const FixedJet<N>& b, double f,
+                                                const Partials& d) {
+  FixedJet<N> r;
+  r.value = f;
+  r.gradient = d.a * a.gradient + d.b * b.gradient;
+  if (d.aa == 0.0 && d.ab == 0.0 && d.bb == 0.0) {
+    r.hessian = d.a * a.hessian + d.b * b.hessian;
+    return r;
+  }
+  const Eigen::Matrix<double, N, 1> u = d.aa * a.gradient + d.ab * b.gradient, w = d.ab * a.gradient + d.bb * b.gradient;
+  r.hessian = d.a * a.hessian + d.b * b.hessian + u * a.gradient.transpose() + w * b.gradient.transpose();
   return r;
 }
 
@@ -207,6 +241,27 @@ struct Jet2 : JetArithmetic<Jet2> {
     for (Eigen::Index k = 0; k < n * n; k += 8) std::memcpy(hessian.data() + k, other.hessian.data() + k, block);
   }
 };
+
+// r += c x in place, for doubles and Jet2: the linear combinations of a Runge-Kutta step and of
+// a matrix of doubles times jets, whose values and derivatives combine alike, without the two
+// temporaries and the copy of r = r + c * x (the same numbers: c x rounded, then added).
+inline void add_scaled(double& r, double c, double x) { r += c * x; }
+inline void add_scaled(Jet2& r, double c, const Jet2& x) {
+  r.value += c * x.value;
+  if (x.constant()) return;
+  const auto n = x.gradient.size();
+  const double* __restrict g = x.gradient.data();
+  const double* __restrict H = x.hessian.data();
+  if (r.constant()) {
+    r.resize(static_cast<int>(n));
+    r.gradient.setZero();
+    r.hessian.setZero();
+  }
+  double* __restrict rg = r.gradient.data();
+  double* __restrict rH = r.hessian.data();
+  for (Eigen::Index i = 0; i < n; ++i) rg[i] += c * g[i];
+  for (Eigen::Index k = 0; k < n * n; ++k) rH[k] += c * H[k];
+}
 
 // A jet over exactly N variables; a constant is one whose derivatives are zero.
 // Default-constructed it is uninitialized, as a double is: Eigen constructs every element of a

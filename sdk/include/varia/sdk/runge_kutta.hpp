@@ -128,10 +128,9 @@ class RungeKutta : public OneStepMethod {
   void stage_point(double h, int i, int count, int N, const T* y0, const std::vector<T>& K,
                    std::vector<T>& Y) const {
     for (int r = 0; r < N; ++r) {
-      T sum = y0[r];
+      T& sum = Y[r] = y0[r];
       for (int j = 0; j < count; ++j)
-        if (t_.a(i, j) != 0.0) sum += (h * t_.a(i, j)) * K[j * N + r];
-      Y[r] = sum;
+        if (t_.a(i, j) != 0.0) add_scaled(sum, h * t_.a(i, j), K[j * N + r]);
     }
   }
 
@@ -149,10 +148,9 @@ class RungeKutta : public OneStepMethod {
       implicit_stages(field, h, y0, report);
     }
     for (int r = 0; r < N; ++r) {
-      T sum = y0[r];
+      T& sum = y1[r] = y0[r];
       for (int i = 0; i < s; ++i)
-        if (t_.b(i) != 0.0) sum += (h * t_.b(i)) * w.K[i * N + r];
-      y1[r] = sum;
+        if (t_.b(i) != 0.0) add_scaled(sum, h * t_.b(i), w.K[i * N + r]);
     }
   }
 
