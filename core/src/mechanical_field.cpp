@@ -92,13 +92,14 @@ void EulerLagrangeField::inverse_mass(const Jet2* w, Jet2* x) const { multiply(i
 // dL/dv (q, v) = p from the value v(q.value, p.value), with the constant matrix L_vv there: the
 // iteration's error has no value part, and each iteration multiplies it by I - L_vv^{-1} L_vv(q,v),
 // whose value part is zero, so two iterations make the first and second derivatives exact.
-void MechanicalField::velocity(const Jet2* y, Jet2* v) {
+const Jet2* MechanicalField::velocity(const Jet2* y) {
   const Jet2* w = y + n_;
-  if (space_ == PhaseSpace::tangent) {
-    std::copy(w, w + n_, v);
-    return;
+  if (space_ == PhaseSpace::tangent) return w;
+  Jet2* v = v_jet_.data();
+  if (constant_mass_) {
+    inverse_mass(w, v);
+    return v;
   }
-  if (constant_mass_) return inverse_mass(w, v);
   const Jet2* q = point(y);
   for (int r = 0; r < n_; ++r) {
     position_[r] = q[r].value;
@@ -115,6 +116,7 @@ void MechanicalField::velocity(const Jet2* y, Jet2* v) {
     multiply(velocity_q_, legendre_residual_.data() + n_, correction_jet_.data());
     for (int r = 0; r < n_; ++r) v[r] -= correction_jet_[r];
   }
+  return v;
 }
 
 void MechanicalField::momentum(const double* q, const double* v, double* p) {
@@ -186,16 +188,16 @@ Status MechanicalField::eval(const double* y, double* f) noexcept {
 
 Status MechanicalField::eval(const Jet2* y, Jet2* f) noexcept {
   return guard([&] {
-    velocity(y, v_jet_.data());
-    lagrangian_.gradient_jet(point(y), v_jet_.data(), nullptr, gradient_jet_.data());
+    const Jet2* v = velocity(y);
+    lagrangian_.gradient_jet(point(y), v, nullptr, gradient_jet_.data());
     if (forced_) {
-      force(y, v_jet_.data(), force_jet_.data());
+      force(y, v, force_jet_.data());
       for (int r = 0; r < n_; ++r) gradient_jet_[r] += force_jet_[r];
     }
-    std::copy(v_jet_.begin(), v_jet_.end(), f);
+    std::copy_n(v, n_, f);
     if (space_ == PhaseSpace::cotangent) std::copy_n(gradient_jet_.begin(), n_, f + n_);
     else if (constant_mass_) inverse_mass(gradient_jet_.data(), f + n_);
-    else acceleration(point(y), v_jet_.data(), f + n_);
+    else acceleration(point(y), v, f + n_);
     if (clock()) f[2 * n_] = Jet2(1.0);
   });
 }

@@ -115,7 +115,6 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   zero_.assign(std::max(m_, n_), 0.0);
   slot_.resize(2 * n_);
   plan_passes(field_->jet_variables());
-  v_.resize(n_);
   acceleration_.resize(n_);
   gradient_.resize(m_ + n_);
   boundary_.resize(n_);
@@ -211,24 +210,23 @@ void ShootingDiscreteLagrangian::accumulate(int node, double h, Jet2& S) {
   const bool first = node == 0, last = node + 1 == static_cast<int>(nodes_.size());
   const double correction = first ? start_correction_ : last ? end_correction_ : 0.0;
   if (weights_[node] == 0.0 && correction == 0.0) return;
-  if (mechanical_ != nullptr) mechanical_->velocity(state_.data(), v_.data());
-  else std::copy_n(state_.begin() + m_, n_, v_.begin());
+  const Jet2* v = mechanical_ != nullptr ? mechanical_->velocity(state_.data()) : state_.data() + m_;
   Jet2 L;
-  lagrangian_.gradient_jet(position(), v_.data(), &L, gradient_.data());
+  lagrangian_.gradient_jet(position(), v, &L, gradient_.data());
   add_scaled(S, h * weights_[node], L);
-  if (forced_) add_work(h * weights_[node]);
+  if (forced_) add_work(h * weights_[node], v);
   if (correction == 0.0) return;
   field_->inverse_mass(gradient_.data(), acceleration_.data());
   Jet2 rate;
-  for (int r = 0; r < n_; ++r) rate += gradient_[r] * v_[r] + gradient_[n_ + r] * acceleration_[r];
+  for (int r = 0; r < n_; ++r) rate += gradient_[r] * v[r] + gradient_[n_ + r] * acceleration_[r];
   add_scaled(S, h * h * correction, rate);
 }
 
 // The virtual work of the forces at node i, weight = h b_i: W_x += weight q^i_x^T f_i and
 // dW_x/dx += weight (sum_r f_ir q^i_r,xx + q^i_x^T f_i,x), f_i = f(t + c_i h, q^i, v^i) at jets
 // (Marsden & West 2001, sec. 3.2, through the quadrature; see shooting.hpp).
-void ShootingDiscreteLagrangian::add_work(double weight) {
-  mechanical_->force(state_.data(), v_.data(), force_.data());
+void ShootingDiscreteLagrangian::add_work(double weight, const Jet2* v) {
+  mechanical_->force(state_.data(), v, force_.data());
   const Jet2* point = position();
   for (int r = 0; r < n_; ++r) {
     const Jet2& q = point[r];

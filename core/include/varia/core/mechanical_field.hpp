@@ -111,9 +111,9 @@ class MechanicalField final : public EulerLagrangeField {
   Status eval(const Jet2* y, Jet2* f) noexcept override;
   Status jacobian(const double* y, double* f, double* df) noexcept override;
 
-  // The velocity of state y: v = w (tangent) or v(q, w) (cotangent: M^{-1} w, or the inverse
-  // Legendre transform at jets).
-  void velocity(const Jet2* y, Jet2* v);
+  // The velocity of state y: its own w (tangent), or v(q, w) (cotangent: M^{-1} w, or the inverse
+  // Legendre transform at jets) in a workspace, valid until the next call.
+  const Jet2* velocity(const Jet2* y);
   // p = dL/dv (q, v) at doubles: the momentum of a velocity (a Newton guess on the cotangent side).
   void momentum(const double* q, const double* v, double* p);
   // v(q, p) at doubles, the inverse: M^{-1} p, or the exact inverse Legendre transform.

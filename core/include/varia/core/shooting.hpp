@@ -140,7 +140,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void shoot(const double* q0, const double* w0, double h);
   void propagate(const double* q0, const double* w0, double h, const Pass& pass);
   void accumulate(int node, double h, Jet2& S);
-  void add_work(double weight);
+  void add_work(double weight, const Jet2* v);
   void gather(const Pass& pass);
   void first_derivatives();
   void second_derivatives(const Pass& pass);
@@ -178,7 +178,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   SolverStatistics statistics_, stages_;
   mutable EvaluationCounters counters_;
   // Workspace, sized once: a step allocates nothing.
-  std::vector<Jet2> state_, next_, v_, acceleration_, gradient_, boundary_, force_;
+  std::vector<Jet2> state_, next_, acceleration_, gradient_, boundary_, force_;
   std::vector<Jet2> origin_;  // q0 + eta: the origin of the state's positions on a vector space
   Jet2 generating_;
   // The natural chart's derivatives (Manifold::chart, local_derivatives), component-major.
