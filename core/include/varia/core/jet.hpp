@@ -242,9 +242,10 @@ struct Jet2 : JetArithmetic<Jet2> {
   }
 };
 
-// r += c x in place, for doubles and Jet2: the linear combinations of a Runge-Kutta step and of
-// a matrix of doubles times jets, whose values and derivatives combine alike, without the two
-// temporaries and the copy of r = r + c * x (the same numbers: c x rounded, then added).
+// r += c x in place (r and x distinct), for doubles and Jet2: the linear combinations of a
+// Runge-Kutta step and of a matrix of doubles times jets, whose values and derivatives combine
+// alike, without the two temporaries and the copy of r = r + c * x (the same numbers: c x
+// rounded, then added).
 inline void add_scaled(double& r, double c, double x) { r += c * x; }
 inline void add_scaled(Jet2& r, double c, const Jet2& x) {
   r.value += c * x.value;
