@@ -90,6 +90,15 @@ void LagrangianEvaluator::gradient_jet(const Jet2* q, const Jet2* v, Jet2* value
     throw NumericalFailure("the Lagrangian's gradient at jets is not finite", std::nan(""), lagrangian_.origin());
 }
 
+void LagrangianEvaluator::shoot(const ShotPlan& plan, const double* q0, const double* w0, double h, Jet2* action,
+                                Jet2* offsets) {
+  check(lagrangian_, lagrangian_.shoot(plan, q0, w0, h, action, offsets), "Lagrangian shot");
+  counters_.hessian += shot_evaluations(plan);
+  bool finite = isfinite(*action);
+  for (int r = 0; r < plan.n; ++r) finite = finite && isfinite(offsets[r]);
+  if (!finite) throw NumericalFailure("the shot is not finite", std::nan(""), lagrangian_.origin());
+}
+
 bool LagrangianEvaluator::verlet_steps(double* q, double* d, double* f, const double* K, long steps) {
   check(lagrangian_, lagrangian_.verlet_steps(q, d, f, K, steps), "Lagrangian Stormer-Verlet steps");
   counters_.gradient += steps;

@@ -145,8 +145,16 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   Bw_.resize(n_, n_);
   phi_.resize(2 * n_, 2 * n_);
   jacobian_.resize(n_, n_);
-  BwT_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
-  jacobian_lu_ = Eigen::PartialPivLU<Eigen::MatrixXd>(n_);
+  BwT_solver_ = SmallDenseSolver(n_);
+  jacobian_solver_ = SmallDenseSolver(n_);
+  const RungeKuttaTableau tableau = method_.explicit_tableau();
+  if (offsets() && form_ == ShootingForm::lagrangian && field_->constant_mass() && forces_.empty() &&
+      !mechanical_->clock() && start_correction_ == 0.0 && end_correction_ == 0.0 && tableau.stages > 0 &&
+      passes_.size() == 1) {
+    shot_plan_ = {tableau, static_cast<int>(nodes_.size()), nodes_.data(), weights_.data(), n_,
+                  field_->inverse_mass().data()};
+    plugin_shoots_ = lagrangian.runs_shots(shot_plan_);
+  }
 }
 
 // The passes of a propagation. When the jets hold all 2n numbers of x = (eta, w0), one pass gives
@@ -287,6 +295,10 @@ void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, doubl
 // Propagates (q^0, w^0) = (q0 exp(eta), w0) as jets in the pass's numbers of x = (eta, w0) through
 // the nodes, then forms the generating function G and the boundary quantity B of the form.
 void ShootingDiscreteLagrangian::propagate(const double* q0, const double* w0, double h, const Pass& pass) {
+  if (plugin_shoots_) {
+    lagrangian_.shoot(shot_plan_, q0, w0, h, &generating_, boundary_.data());
+    return;
+  }
   std::fill(slot_.begin(), slot_.end(), -1);
   for (std::size_t j = 0; j < pass.variables.size(); ++j) slot_[pass.variables[j]] = static_cast<int>(j);
   start_point(q0);
@@ -371,8 +383,8 @@ void ShootingDiscreteLagrangian::gather(const Pass& pass) {
 // With offsets (on a vector space, Type I forms) B_q = I + Bq_, and the momentum change of the
 // step is D1 + D2 = alpha_q - Bq_^T lambda: small terms, each to its own relative precision.
 void ShootingDiscreteLagrangian::first_derivatives() {
-  BwT_lu_.compute(Bw_.transpose());
-  lambda_.noalias() = BwT_lu_.solve(alpha_.tail(n_));
+  BwT_solver_.compute(Bw_.transpose());
+  BwT_solver_.solve(alpha_.tail(n_), lambda_);
   D1_ = alpha_.head(n_);
   D1_.noalias() -= Bq_.transpose() * lambda_;
   if (offsets()) {
@@ -405,7 +417,7 @@ void ShootingDiscreteLagrangian::residual(Target target, const double* data) {
       residual_ = D1_;
       if (type_2()) residual_ -= given;
       else residual_ += given;
-      lambda_jacobian_.noalias() = BwT_lu_.solve(phi_ww);
+      BwT_solver_.solve(phi_ww, lambda_jacobian_);
       jacobian_ = phi_.topRightCorner(n_, n_);
       jacobian_.noalias() -= Bq_.transpose() * lambda_jacobian_;
       if (offsets()) jacobian_ -= lambda_jacobian_;
@@ -416,7 +428,7 @@ void ShootingDiscreteLagrangian::residual(Target target, const double* data) {
       break;
     case Target::lambda:
       residual_ = lambda_ - given;
-      jacobian_ = BwT_lu_.solve(phi_ww);
+      BwT_solver_.solve(phi_ww, jacobian_);
       break;
   }
 }
@@ -441,8 +453,8 @@ struct ShootingDiscreteLagrangian::Equations {
     for (int r = 0; r < s.n_; ++r) yardstick = std::max(yardstick, std::abs(s.boundary_[r].value));
     return yardstick;
   }
-  void factorize() { s.jacobian_lu_.compute(s.jacobian_); }
-  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { update.noalias() = s.jacobian_lu_.solve(F); }
+  void factorize() { s.jacobian_solver_.compute(s.jacobian_); }
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) { s.jacobian_solver_.solve(F, update); }
   double apply(const Eigen::VectorXd& update) {
     s.w_ -= update;
     return s.w_.lpNorm<Eigen::Infinity>();

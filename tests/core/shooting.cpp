@@ -510,3 +510,55 @@ TEST_SUITE("long") {
     }
   }
 }
+
+namespace {
+
+// rk4 that does not give its Butcher tableau: the shooting construction then propagates through
+// the method's steps (the field's plugin calls), not inside the Lagrangian's plugin.
+struct TableaulessRk4 : OneStepMethod {
+  sdk::RungeKutta method = rk4();
+  int order() const noexcept override { return method.order(); }
+  bool self_adjoint() const noexcept override { return method.self_adjoint(); }
+  const char* equivariance() const noexcept override { return method.equivariance(); }
+  void set_solver(double tolerance, int max_iterations) noexcept override { method.set_solver(tolerance, max_iterations); }
+  Status step(VectorField& field, double h, const double* y0, double* y1, StageSolve* report) noexcept override {
+    return method.step(field, h, y0, y1, report);
+  }
+  Status step(VectorField& field, double h, const Jet2* y0, Jet2* y1, StageSolve* report) noexcept override {
+    return method.step(field, h, y0, y1, report);
+  }
+};
+
+}  // namespace
+
+TEST_CASE("the shot inside the Lagrangian's plugin (explicit_shot.hpp) takes the steps of the propagation through "
+          "the method, with 9 evaluations a shot of SVIRK4 instead of 11, where the plan allows it") {
+  for (int n : {1, 2, 3, 4}) {
+    CAPTURE(n);
+    Pendulums pendulums(n);
+    auto rule = simpson();
+    auto method = rk4();
+    TableaulessRk4 tableauless;
+    FlatSpace space(n);
+    ShootingDiscreteLagrangian inside(space, pendulums, rule, method, ShootingForm::lagrangian, {});
+    ShootingDiscreteLagrangian through(space, pendulums, rule, tableauless, ShootingForm::lagrangian, {});
+    const Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(n, 0.3, 1.2), p = Eigen::VectorXd::LinSpaced(n, 0.1, -0.4);
+    const Eigen::VectorXd a = run(inside, q, p, 0.05, 100), b = run(through, q, p, 0.05, 100);
+    CAPTURE(a.transpose());
+    CHECK((a - b).lpNorm<Eigen::Infinity>() <= 1e-14 * a.lpNorm<Eigen::Infinity>());
+    // A shot is one solve iteration: through the method L at 3 nodes and the field at 8 stages;
+    // inside the plugin one evaluation a node gives L and the next step's first stage (n <= 3,
+    // sdk::kMaxShotDimension; above it the construction propagates through the method).
+    const long shots = inside.solver_statistics().iterations;
+    CHECK(inside.evaluations().hessian == (n <= 3 ? 9 : 11) * shots);
+    CHECK(through.evaluations().hessian == 11 * through.solver_statistics().iterations);
+  }
+  // Not the recurrence: the hamiltonian form integrates (q, p), and propagates through the method.
+  SeparablePendulum pendulum;
+  auto rule = simpson();
+  auto method = rk4();
+  FlatSpace space(1);
+  ShootingDiscreteLagrangian hamiltonian(space, pendulum, rule, method, ShootingForm::hamiltonian, {});
+  run(hamiltonian, Eigen::VectorXd::Constant(1, 1.0), Eigen::VectorXd::Constant(1, 0.5), 0.05, 10);
+  CHECK(hamiltonian.evaluations().hessian == 11 * hamiltonian.solver_statistics().iterations);
+}

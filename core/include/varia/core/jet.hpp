@@ -95,8 +95,9 @@ J binary(const J& a, const J& b, double f, const Partials& d) {
 }
 
 // The same chain rule at a fixed number N of variables, inlined into each operation: there the
-// sizes are constants and a jet is never constant, so that it is a few fixed-size vector
-// operations, and where the partials are constants (a sum's 1, 1, 0, 0, 0) the terms they zero
+// sizes are constants and a jet is never constant, so that it is a few fixed-size loops the
+// compiler unrolls (the outer products as loops: as Eigen expressions GCC left their assignment
+// out of line, a quarter of a shot), and where the partials are constants (a sum's 1, 1, 0, 0, 0) the terms they zero
 // go. The terms are those of the loops above, summed in the same order, so that both give the
 // same numbers; the zero ones are skipped as there (0 * an infinite gradient would make NaN). A SVIRK4
 // step of the pendulum, whose model the SDK evaluates at dual numbers over FixedJet<2>: 4.57 ->
@@ -106,8 +107,14 @@ template <int N>
   FixedJet<N> r;
   r.value = f;
   r.gradient = d1 * a.gradient;
-  r.hessian = d1 * a.hessian;
-  if (d2 != 0.0) r.hessian.noalias() += a.gradient * (d2 * a.gradient).transpose();
+  if (d2 == 0.0) {
+    r.hessian = d1 * a.hessian;
+    return r;
+  }
+  for (int j = 0; j < N; ++j) {
+    const double c = d2 * a.gradient[j];
+    for (int i = 0; i < N; ++i) r.hessian(i, j) = d1 * a.hessian(i, j) + c * a.gradient[i];
+  }
   return r;
 }
 template <int N>
@@ -120,8 +127,14 @@ template <int N>
     r.hessian = d.a * a.hessian + d.b * b.hessian;
     return r;
   }
-  const Eigen::Matrix<double, N, 1> u = d.aa * a.gradient + d.ab * b.gradient, w = d.ab * a.gradient + d.bb * b.gradient;
-  r.hessian = d.a * a.hessian + d.b * b.hessian + u * a.gradient.transpose() + w * b.gradient.transpose();
+  double u[N], w[N];
+  for (int i = 0; i < N; ++i) {
+    u[i] = d.aa * a.gradient[i] + d.ab * b.gradient[i];
+    w[i] = d.ab * a.gradient[i] + d.bb * b.gradient[i];
+  }
+  for (int j = 0; j < N; ++j)
+    for (int i = 0; i < N; ++i)
+      r.hessian(i, j) = d.a * a.hessian(i, j) + d.b * b.hessian(i, j) + u[i] * a.gradient[j] + w[i] * b.gradient[j];
   return r;
 }
 
@@ -242,7 +255,7 @@ struct Jet2 : JetArithmetic<Jet2> {
   }
 };
 
-// r += c x in place (r and x distinct), for doubles and Jet2: the linear combinations of a
+// r += c x in place (r and x distinct), for doubles and Jet2 (FixedJet below): the linear combinations of a
 // Runge-Kutta step and of a matrix of doubles times jets, whose values and derivatives combine
 // alike, without the two temporaries and the copy of r = r + c * x (the same numbers: c x
 // rounded, then added).
@@ -285,6 +298,12 @@ struct FixedJet : JetArithmetic<FixedJet<N>> {
     jet.hessian = hessian;
     return jet;
   }
+  // The independent variable `index` of `count` (= N), at `x`.
+  static FixedJet variable(double x, int /*count*/, int index) {
+    FixedJet jet(x);
+    jet.gradient[index] = 1.0;
+    return jet;
+  }
   bool constant() const { return false; }
   void resize(int) {}
 
@@ -292,6 +311,14 @@ struct FixedJet : JetArithmetic<FixedJet<N>> {
   Eigen::Matrix<double, N, 1> gradient;
   Eigen::Matrix<double, N, N> hessian;
 };
+
+// r += c x in place, as for Jet2 (the same numbers).
+template <int N>
+inline void add_scaled(FixedJet<N>& r, double c, const FixedJet<N>& x) {
+  r.value += c * x.value;
+  r.gradient += c * x.gradient;
+  r.hessian += c * x.hessian;
+}
 
 // The value of a double or a jet: code written once for both scalars tests it.
 inline double value_of(double x) { return x; }

@@ -3,6 +3,7 @@
 // The gradient is [dL/dq (m), dL/dv (n)]; on a Lie group dL/dq is the gradient in the embedding.
 #pragma once
 
+#include "varia/core/explicit_shot.hpp"
 #include "varia/core/jet.hpp"
 #include "varia/core/plugin_object.hpp"
 
@@ -53,6 +54,18 @@ class Lagrangian : public PluginObject {
   virtual Status verlet_steps(double* /*q*/, double* /*d*/, double* /*f*/, const double* /*K*/,
                               long /*steps*/) noexcept {
     return "this Lagrangian does not run Stormer-Verlet steps (derive it from sdk::AutodiffLagrangian)";
+  }
+  // The shooting construction's shot run inside the plugin (explicit_shot.hpp: an explicit
+  // Runge-Kutta method, L = 1/2 v^T M v - V(q) with a constant mass matrix on R^n with m = n, no
+  // forces): the action S into `action` and the end's offsets q^n - (q0 + eta) into `offsets` (n),
+  // jets of the 2n variables x = (eta, w0), from one call instead of one a stage and a node.
+  // runs_shots(plan) says whether the plugin takes that plan (its n and number of stages); the
+  // numbers must be those of explicit_shot with dL/dq from gradient_jet (the conformance suite
+  // checks it). ABI 14.
+  virtual bool runs_shots(const ShotPlan& /*plan*/) const noexcept { return false; }
+  virtual Status shoot(const ShotPlan& /*plan*/, const double* /*q0*/, const double* /*w0*/, double /*h*/,
+                       Jet2* /*action*/, Jet2* /*offsets*/) noexcept {
+    return "this Lagrangian does not run shots (derive it from sdk::AutodiffLagrangian)";
   }
   // L and its gradient [dL/dq, dL/dv] at jet inputs (q, v): the jets of L(q(x), v(x)) and of its
   // gradient for the jet variables x (value may be null). The shooting construction integrates

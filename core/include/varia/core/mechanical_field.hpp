@@ -64,6 +64,7 @@ class EulerLagrangeField : public VectorField {
   void step(OneStepMethod& method, double h, const Jet2* y0, Jet2* y1, SolverStatistics& stages);
 
   const Eigen::MatrixXd& mass() const { return mass_; }
+  const Eigen::MatrixXd& inverse_mass() const { return inverse_mass_; }
   // x = M^{-1} w, at doubles or jets: the velocity of a momentum, the acceleration of a force.
   void inverse_mass(const double* w, double* x) const;
   void inverse_mass(const Jet2* w, Jet2* x) const;

@@ -55,6 +55,10 @@ class LagrangianEvaluator {
   // end shows any. q, d, f are then unspecified; the caller retakes the steps a gradient at a time,
   // which finds the step that fails.
   bool verlet_steps(double* q, double* d, double* f, const double* K, long steps);
+  // The shooting construction's shot run inside the plugin (Lagrangian::shoot, where
+  // plugin().runs_shots(plan)), counted as its evaluations at jets (shot_evaluations). Throws
+  // NumericalFailure where S or an offset is not finite.
+  void shoot(const ShotPlan& plan, const double* q0, const double* w0, double h, Jet2* action, Jet2* offsets);
   const EvaluationCounters& counters() const { return counters_; }
 
   // p = dL/dv (q, v).

@@ -20,7 +20,8 @@ namespace varia {
 // 10: Lagrangian::hessian_jet, Lagrangian::hessian_jet_variables.
 // 11: Effect::gradient_jet, Effect::evaluates_at_jets; 12: Lagrangian::has_constant_mass_matrix;
 // 13: Lagrangian::runs_verlet_steps, Lagrangian::verlet_steps, Lagrangian::gradients.
-inline constexpr int kAbiVersion = 13;
+// 14: Lagrangian::runs_shots, Lagrangian::shoot, OneStepMethod::explicit_tableau.
+inline constexpr int kAbiVersion = 14;
 
 using Status = const char*;
 

@@ -60,6 +60,11 @@
 // over blocks of x, and of the second derivatives only Phi's columns in w0, the Newton Jacobian's,
 // over pairs of blocks. Every pass has the same values; together they give the one-pass derivatives.
 //
+// Where the shot is one fixed recurrence (an explicit Runge-Kutta method, the lagrangian form on
+// R^n, a constant mass matrix, no forces, no end corrections: explicit_shot.hpp), the Lagrangian's
+// plugin runs it whole with its model inlined (Lagrangian::shoot), where it takes the plan (the
+// SDK's models: n <= 3); the same numbers as the propagation through the method's plugin.
+//
 // Restrictions: a Lie group of dimension n <= 6 (one pass of jets of 2n <= 12 variables: SE(3));
 // R^n of any dimension. The lagrangian form with a configuration-dependent mass matrix needs L's
 // Hessian at jets of at least 2 variables (the SDK gives 6); the hamiltonian and type-2 forms take
@@ -80,6 +85,7 @@
 #include "varia/core/one_step.hpp"
 #include "varia/core/quadrature.hpp"
 #include "varia/core/solve/newton.hpp"
+#include "varia/core/solve/small_dense.hpp"
 
 namespace varia {
 
@@ -177,6 +183,11 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   bool second_order_ = true;     // whether the current solve needs Phi (its Jacobian does)
   SolverStatistics statistics_, stages_;
   mutable EvaluationCounters counters_;
+  // The shot run inside the Lagrangian's plugin where it is explicit_shot.hpp's recurrence (an
+  // explicit Runge-Kutta method, the lagrangian form on R^n, a constant mass matrix, no forces,
+  // no end corrections, one pass) and the plugin takes the plan: one call a shot.
+  ShotPlan shot_plan_;
+  bool plugin_shoots_ = false;
   // Workspace, sized once: a step allocates nothing.
   std::vector<Jet2> state_, next_, acceleration_, gradient_, boundary_, force_;
   std::vector<Jet2> origin_;  // q0 + eta: the origin of the state's positions on a vector space
@@ -202,7 +213,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::VectorXd guess_;
   Eigen::MatrixXd corrections_history_;
   int corrections_ = 0;
-  Eigen::PartialPivLU<Eigen::MatrixXd> BwT_lu_, jacobian_lu_;  // of B_w^T and the Jacobian
+  SmallDenseSolver BwT_solver_, jacobian_solver_;  // of B_w^T and the Jacobian
 };
 
 }  // namespace varia

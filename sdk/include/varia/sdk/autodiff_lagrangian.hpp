@@ -105,6 +105,25 @@ class AutodiffLagrangian : public Lagrangian {
     });
   }
 
+  // The shooting construction's shot with the model inlined (explicit_shot.hpp): for m = n up to
+  // kMaxShotDimension and explicit methods of up to kMaxShotStages stages.
+  bool runs_shots(const ShotPlan& plan) const noexcept final {
+    return m_ == n_ && plan.n == n_ && n_ <= kMaxShotDimension && plan.method.stages <= kMaxShotStages;
+  }
+  Status shoot(const ShotPlan& plan, const double* q0, const double* w0, double h, Jet2* action,
+               Jet2* offsets) noexcept final {
+    return guarded(error_, [&] {
+      if (!runs_shots(plan))
+        throw std::length_error("an autodiff Lagrangian runs shots for m = n <= " + std::to_string(kMaxShotDimension) +
+                                " and explicit methods of at most " + std::to_string(kMaxShotStages) + " stages");
+      switch (n_) {
+        case 1: return fixed_shot<1>(plan, q0, w0, h, action, offsets);
+        case 2: return fixed_shot<2>(plan, q0, w0, h, action, offsets);
+        default: return fixed_shot<3>(plan, q0, w0, h, action, offsets);
+      }
+    });
+  }
+
   // At jets the model runs at dual numbers on the stack: up to kStackVariables numbers (q, v). Above
   // that the shooting construction refuses the Lagrangian when it is built (validate, exit 2).
   bool evaluates_at_jets() const noexcept final { return m_ + n_ <= kStackVariables; }
@@ -247,6 +266,40 @@ class AutodiffLagrangian : public Lagrangian {
       d_out = increment;
       f_out = dLdq;
     }
+  }
+#pragma GCC diagnostic pop
+
+  // A shot at n = N (jets of 2N variables, FixedJet): the recurrence of explicit_shot.hpp with the
+  // model inlined (flatten) at dual numbers over the jets in the N directions of q, which give L
+  // and dL/dq together (the velocities' directions, which the field of a constant mass matrix does
+  // not use, are not taken). The model reads only the first N inputs of its vectors (as at_fixed_jets).
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wuninitialized"
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+  template <int N>
+  [[gnu::noinline, gnu::flatten]] void fixed_shot(const ShotPlan& plan, const double* q0, const double* w0, double h,
+                                                  Jet2* action, Jet2* offsets) const {
+    using J = FixedJet<2 * N>;
+    using D = JetDual<N, J>;
+    std::array<J, 10 * N + 2 * N * kMaxShotStages> work;
+    std::array<J, N> end;
+    J S;
+    explicit_shot(plan, q0, w0, h, S, end.data(), work.data(), [&](const J* q, const J* v, J* L, J* Lq) {
+      Vec<D> qd(N), vd(N);
+      for (int r = 0; r < N; ++r) {
+        qd(r).value() = q[r];
+        vd(r).value() = v[r];
+        for (int d = 0; d < N; ++d) {
+          qd(r).derivatives()(d) = J(d == r ? 1.0 : 0.0);
+          vd(r).derivatives()(d) = J(0.0);
+        }
+      }
+      const D result = model().lagrangian(qd, vd);
+      if (L != nullptr) *L = result.value();
+      for (int r = 0; r < N; ++r) Lq[r] = result.derivatives()(r);
+    });
+    *action = S.to_jet2();
+    for (int r = 0; r < N; ++r) offsets[r] = end[r].to_jet2();
   }
 #pragma GCC diagnostic pop
 

@@ -17,6 +17,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "varia/core/explicit_shot.hpp"
 #include "varia/core/one_step.hpp"
 #include "varia/core/solve/newton.hpp"
 #include "varia/sdk/plugin.hpp"
@@ -87,6 +88,9 @@ class RungeKutta : public OneStepMethod {
         explicit_(t_.is_explicit()),
         order_(order),
         self_adjoint_(self_adjoint) {}
+  RungeKuttaTableau explicit_tableau() const noexcept final {
+    return explicit_ ? view() : RungeKuttaTableau{};
+  }
   int order() const noexcept final { return order_; }
   bool self_adjoint() const noexcept final { return self_adjoint_; }
   const char* equivariance() const noexcept final { return "affine"; }
@@ -123,35 +127,28 @@ class RungeKutta : public OneStepMethod {
     if (Status status = field.eval(y, f)) throw std::runtime_error(status);
   }
 
+  // The tableau as the core's recurrences take it (explicit_shot.hpp).
+  RungeKuttaTableau view() const { return {t_.stages(), t_.a.data(), t_.b.data(), t_.c.data()}; }
+
   // Y = y0 + h sum_{j in [0, count)} a_ij K_j.
   template <class T>
   void stage_point(double h, int i, int count, int N, const T* y0, const std::vector<T>& K,
                    std::vector<T>& Y) const {
-    for (int r = 0; r < N; ++r) {
-      T& sum = Y[r] = y0[r];
-      for (int j = 0; j < count; ++j)
-        if (t_.a(i, j) != 0.0) add_scaled(sum, h * t_.a(i, j), K[j * N + r]);
-    }
+    runge_kutta_stage_point(view(), h, i, count, N, y0, K.data(), Y.data());
   }
 
   template <class T>
   void advance(VectorField& field, double h, const T* y0, T* y1, StageSolve& report) {
-    const int N = field.size(), s = t_.stages();
+    const int N = field.size();
     Workspace<T>& w = workspace<T>(N);
     report = StageSolve{};
     if (explicit_) {
-      for (int i = 0; i < s; ++i) {
-        stage_point(h, i, i, N, y0, w.K, w.Y);
-        eval(field, w.Y.data(), &w.K[i * N]);
-      }
-    } else {
-      implicit_stages(field, h, y0, report);
+      explicit_runge_kutta_step(view(), h, N, y0, y1, w.K.data(), w.Y.data(),
+                                [&](const T* y, T* f) { eval(field, y, f); });
+      return;
     }
-    for (int r = 0; r < N; ++r) {
-      T& sum = y1[r] = y0[r];
-      for (int i = 0; i < s; ++i)
-        if (t_.b(i) != 0.0) add_scaled(sum, h * t_.b(i), w.K[i * N + r]);
-    }
+    implicit_stages(field, h, y0, report);
+    runge_kutta_combination(view(), h, N, y0, w.K.data(), y1);
   }
 
   // The stage equations G_i(K) = K_i - f(Y_i) = 0 at doubles and their Newton matrix

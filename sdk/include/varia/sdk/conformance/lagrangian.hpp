@@ -5,7 +5,8 @@
 // and Hessian at jets (gradient_jet, hessian_jet, where the Lagrangian gives them) carry the values
 // at doubles and derivatives that pass Taylor tests against them; gradients() at several points is
 // evaluate() at each; the explicit form's
-// Stormer-Verlet steps, where the plugin runs them itself, are those of the recurrence.
+// Stormer-Verlet steps and the shooting construction's shots, where the plugin runs them itself,
+// are those of their recurrences.
 #pragma once
 
 #include <Eigen/Dense>
@@ -17,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "varia/core/explicit_shot.hpp"
 #include "varia/core/lagrangian.hpp"
 #include "varia/core/stormer_verlet.hpp"
 #include "varia/sdk/conformance/failures.hpp"
@@ -167,6 +169,48 @@ inline void check_verlet_steps(Lagrangian& lagrangian, const VectorXd& q, const 
                   " away from the Stormer-Verlet recurrence with dL/dq from evaluate() (5 steps of h = 0.1)");
 }
 
+// The largest difference of two jets' values and derivatives, relative to the reference's size.
+inline double jet_gap(const Jet2& jet, const Jet2& reference) {
+  double scale = std::max(1.0, std::abs(reference.value)), error = std::abs(jet.value - reference.value);
+  if (reference.constant() || jet.constant()) return (jet.constant() != reference.constant() ? 1.0 : error) / scale;
+  if (jet.gradient.size() != reference.gradient.size()) return 1.0;
+  scale = std::max({scale, reference.gradient.cwiseAbs().maxCoeff(), reference.hessian.cwiseAbs().maxCoeff()});
+  error = std::max({error, (jet.gradient - reference.gradient).cwiseAbs().maxCoeff(),
+                    (jet.hessian - reference.hessian).cwiseAbs().maxCoeff()});
+  return error / scale;
+}
+
+// Where the plugin runs the shooting construction's shots itself (runs_shots) and declares a
+// constant mass matrix: a shot of rk4 through Simpson's nodes (the paper's SVIRK4) from (q, w0 = v)
+// at h = 0.1 gives S and the end's offsets, values and first and second derivatives in (eta, w0),
+// of the recurrence (explicit_shot.hpp) with L and dL/dq from gradient_jet, to round-off.
+inline void check_shot(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v, Failures& failures) {
+  const int n = lagrangian.velocity_size();
+  MatrixXd mass(n, n);
+  if (lagrangian.position_size() != n || !lagrangian.evaluates_at_jets() ||
+      !lagrangian.constant_mass_matrix(mass.data()))
+    return;
+  const MatrixXd inverse_mass = mass.inverse();
+  static constexpr double a[16] = {0, 0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 1, 0, 0, 0, 0};
+  static constexpr double b[4] = {1.0 / 6, 1.0 / 3, 1.0 / 3, 1.0 / 6}, c[4] = {0, 0.5, 0.5, 1};
+  static constexpr double nodes[3] = {0, 0.5, 1}, weights[3] = {1.0 / 6, 4.0 / 6, 1.0 / 6};
+  const ShotPlan plan{{4, a, b, c}, 3, nodes, weights, n, inverse_mass.data()};
+  if (!lagrangian.runs_shots(plan)) return;
+  const double h = 0.1;
+  std::vector<Jet2> offsets(n), reference_offsets(n), work(shot_workspace(plan)), gradient(2 * n);
+  Jet2 action, reference_action;
+  check(lagrangian, lagrangian.shoot(plan, q.data(), v.data(), h, &action, offsets.data()), "shoot");
+  explicit_shot(plan, q.data(), v.data(), h, reference_action, reference_offsets.data(), work.data(),
+                [&](const Jet2* x, const Jet2* w, Jet2* L, Jet2* Lq) {
+                  check(lagrangian, lagrangian.gradient_jet(x, w, L, gradient.data()), "Lagrangian gradient at jets");
+                  std::copy_n(gradient.begin(), n, Lq);
+                });
+  double error = jet_gap(action, reference_action);
+  for (int r = 0; r < n; ++r) error = std::max(error, jet_gap(offsets[r], reference_offsets[r]));
+  failures.expect(error <= 1e-13, "shoot gives S and the offsets ", error,
+                  " (relative) away from the recurrence of explicit_shot.hpp with gradient_jet (rk4, Simpson, h = 0.1)");
+}
+
 // The claims at one point (q, v).
 inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q, const VectorXd& v,
                         Failures& failures) {
@@ -214,6 +258,7 @@ inline void check_point(Lagrangian& lagrangian, unsigned seed, const VectorXd& q
   if (lagrangian.momentum_size() > 0) check_symmetry(lagrangian, seed, q, v, e.value, failures);
   check_jets(lagrangian, seed, q, v, failures);
   check_verlet_steps(lagrangian, q, v, failures);
+  check_shot(lagrangian, q, v, failures);
 }
 
 // The whole suite on one Lagrangian, at `trials` random points.

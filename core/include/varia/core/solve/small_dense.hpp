@@ -1,0 +1,43 @@
+// Repeated solves with one small dense matrix A: for n <= 4 Eigen's closed-form inverse of a
+// fixed-size matrix (cofactors: no pivot search, no blocking), so that a solve is a product of a
+// few flops; above, Eigen's PartialPivLU. Eigen's PartialPivLU of a dynamic matrix pays its
+// blocking and dispatch at every size, and a solve with a matrix right-hand side packs it as for
+// a large product: on the 1-DOF pendulum the shooting step's two factorizations and three solves
+// took a sixth of the step (issue #19). A singular A gives non-finite solutions in either case;
+// the callers' solves check their residuals.
+#pragma once
+
+#include <Eigen/Core>
+#include <Eigen/LU>
+
+namespace varia {
+
+class SmallDenseSolver {
+ public:
+  SmallDenseSolver() = default;
+  explicit SmallDenseSolver(int n) : n_(n), inverse_(n, n), lu_(n) {}
+
+  template <class Matrix>
+  void compute(const Matrix& A) {
+    switch (n_) {
+      case 1: inverse_(0, 0) = 1.0 / A(0, 0); return;
+      case 2: inverse_ = Eigen::Matrix2d(A).inverse(); return;
+      case 3: inverse_ = Eigen::Matrix3d(A).inverse(); return;
+      case 4: inverse_ = Eigen::Matrix4d(A).inverse(); return;
+      default: lu_.compute(A);
+    }
+  }
+  // x = A^{-1} b, b a vector or a matrix (x distinct from b).
+  template <class Rhs, class Result>
+  void solve(const Rhs& b, Result& x) const {
+    if (n_ <= 4) x.noalias() = inverse_ * b;
+    else x.noalias() = lu_.solve(b);
+  }
+
+ private:
+  int n_ = 0;
+  Eigen::MatrixXd inverse_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+};
+
+}  // namespace varia
