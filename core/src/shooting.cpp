@@ -295,6 +295,8 @@ void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, doubl
 // Propagates (q^0, w^0) = (q0 exp(eta), w0) as jets in the pass's numbers of x = (eta, w0) through
 // the nodes, then forms the generating function G and the boundary quantity B of the form.
 void ShootingDiscreteLagrangian::propagate(const double* q0, const double* w0, double h, const Pass& pass) {
+  work_gradient_.setZero(jet_size_);
+  work_jacobian_.setZero(jet_size_, jet_size_);
   if (plugin_shoots_) {
     lagrangian_.shoot(shot_plan_, q0, w0, h, &generating_, boundary_.data());
     return;
@@ -305,8 +307,6 @@ void ShootingDiscreteLagrangian::propagate(const double* q0, const double* w0, d
   for (int r = 0; r < n_; ++r) state_[m_ + r] = seeded(w0[r], n_ + r);
   if (mechanical_ != nullptr && mechanical_->clock()) state_[2 * n_] = Jet2(t_);
   if (mechanical_ != nullptr) mechanical_->set_forced(forced_);
-  work_gradient_.setZero(jet_size_);
-  work_jacobian_.setZero(jet_size_, jet_size_);
   Jet2 S;
   accumulate(0, h, S);
   for (std::size_t i = 1; i < nodes_.size(); ++i) {

@@ -254,9 +254,7 @@ struct Coefficient {
   double value, d1, d2;
   template <class F>
   static Coefficient at(double x, F&& c) {
-    FixedJet<1> variable(x);
-    variable.gradient(0) = 1.0;
-    const FixedJet<1> y = c(variable);
+    const FixedJet<1> y = c(FixedJet<1>::variable(x, 1, 0));
     return {y.value, y.gradient(0), y.hessian(0, 0)};
   }
 };

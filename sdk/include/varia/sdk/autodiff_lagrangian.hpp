@@ -365,6 +365,7 @@ class AutodiffLagrangian : public Lagrangian {
       const Jet2& x = at(q, v, m_, i);
       z[i] = FixedJet<N>(x.value);
       if (x.constant()) continue;
+      z[i].is_constant = false;
       z[i].gradient.head(variables) = x.gradient;
       z[i].hessian.topLeftCorner(variables, variables) = x.hessian;
     }

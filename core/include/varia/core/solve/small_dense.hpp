@@ -27,11 +27,21 @@ class SmallDenseSolver {
       default: lu_.compute(A);
     }
   }
-  // x = A^{-1} b, b a vector or a matrix (x distinct from b).
+  // x = A^{-1} b, b a vector or a matrix (x distinct from b, of b's size). For n <= 4 the product
+  // by plain loops: Eigen's product of dynamic matrices chooses its kernel at run time, which
+  // costs more than these few flops.
   template <class Rhs, class Result>
   void solve(const Rhs& b, Result& x) const {
-    if (n_ <= 4) x.noalias() = inverse_ * b;
-    else x.noalias() = lu_.solve(b);
+    if (n_ > 4) {
+      x.noalias() = lu_.solve(b);
+      return;
+    }
+    for (Eigen::Index c = 0; c < b.cols(); ++c)
+      for (int r = 0; r < n_; ++r) {
+        double sum = 0.0;
+        for (int k = 0; k < n_; ++k) sum += inverse_(r, k) * b(k, c);
+        x(r, c) = sum;
+      }
   }
 
  private:
