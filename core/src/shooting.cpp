@@ -149,8 +149,7 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   jacobian_solver_ = SmallDenseSolver(n_);
   const RungeKuttaTableau tableau = method_.explicit_tableau();
   if (offsets() && form_ == ShootingForm::lagrangian && field_->constant_mass() && forces_.empty() &&
-      !mechanical_->clock() && start_correction_ == 0.0 && end_correction_ == 0.0 && tableau.stages > 0 &&
-      passes_.size() == 1) {
+      start_correction_ == 0.0 && end_correction_ == 0.0 && tableau.stages > 0 && passes_.size() == 1) {
     shot_plan_ = {tableau, static_cast<int>(nodes_.size()), nodes_.data(), weights_.data(), n_,
                   field_->inverse_mass().data()};
     plugin_shoots_ = lagrangian.runs_shots(shot_plan_);
