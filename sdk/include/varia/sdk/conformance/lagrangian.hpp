@@ -23,6 +23,7 @@
 #include "varia/core/stormer_verlet.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 #include "varia/sdk/conformance/taylor.hpp"
+#include "varia/sdk/runge_kutta.hpp"
 
 namespace varia::sdk::conformance {
 
@@ -191,10 +192,10 @@ inline void check_shot(Lagrangian& lagrangian, const VectorXd& q, const VectorXd
       !lagrangian.constant_mass_matrix(mass.data()))
     return;
   const MatrixXd inverse_mass = mass.inverse();
-  static constexpr double a[16] = {0, 0.5, 0, 0, 0, 0, 0.5, 0, 0, 0, 0, 1, 0, 0, 0, 0};
-  static constexpr double b[4] = {1.0 / 6, 1.0 / 3, 1.0 / 3, 1.0 / 6}, c[4] = {0, 0.5, 0.5, 1};
+  const ButcherTableau rk4 = classic_rk4();
   static constexpr double nodes[3] = {0, 0.5, 1}, weights[3] = {1.0 / 6, 4.0 / 6, 1.0 / 6};
-  const ShotPlan plan{{4, a, b, c}, 3, nodes, weights, n, inverse_mass.data()};
+  const ShotPlan plan{{rk4.stages(), rk4.a.data(), rk4.b.data(), rk4.c.data()}, 3, nodes, weights, n,
+                      inverse_mass.data()};
   if (!lagrangian.runs_shots(plan)) return;
   const double h = 0.1;
   std::vector<Jet2> offsets(n), reference_offsets(n), work(shot_workspace(plan)), gradient(2 * n);
