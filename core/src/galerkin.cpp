@@ -8,6 +8,7 @@
 #include <type_traits>
 
 #include "varia/core/compensated.hpp"
+#include "varia/core/fixed_size.hpp"
 #include "varia/core/stormer_verlet.hpp"
 
 namespace varia {
@@ -38,25 +39,6 @@ void check_control_times(const std::vector<double>& d) {
     throw std::invalid_argument("control times must start at 0 and end at 1");
   for (std::size_t i = 1; i < d.size(); ++i)
     if (!(d[i] > d[i - 1])) throw std::invalid_argument("control times must increase");
-}
-
-// f(std::integral_constant<int, N>{}) with N = n for n <= 4, N = Eigen::Dynamic otherwise: the
-// fixed-size instance of a member template, chosen once.
-template <class F>
-auto for_dimension(int n, F f) {
-  switch (n) {
-    case 1: return f(std::integral_constant<int, 1>{});
-    case 2: return f(std::integral_constant<int, 2>{});
-    case 3: return f(std::integral_constant<int, 3>{});
-    case 4: return f(std::integral_constant<int, 4>{});
-    default: return f(std::integral_constant<int, Eigen::Dynamic>{});
-  }
-}
-
-// A size fixed at compile time, or the run-time one where it is Eigen::Dynamic.
-template <int Fixed>
-constexpr int fixed_or(int runtime) {
-  return Fixed == Eigen::Dynamic ? runtime : Fixed;
 }
 
 // f(N, R) with N = n and R = the number of nodes as compile-time constants for n <= 4 and R <= 7

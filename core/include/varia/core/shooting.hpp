@@ -143,17 +143,31 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Jet2 seeded(double value, int variable) const;
   void start_point(const double* q0);
   void boundary();
+  // The members templated on N do the shooting Newton's algebra on vectors of N = n numbers and
+  // N x N matrices, N fixed at compile time on R^n for n <= 4 (fixed_size.hpp: chosen once, step_),
+  // else Eigen::Dynamic.
+  template <int N>
+  void step_at(const double* q0, const double* p0, double h, double* q1, double* p1);
+  using StepFunction = void (ShootingDiscreteLagrangian::*)(const double*, const double*, double, double*, double*);
+  StepFunction step_ = nullptr;
+  template <int N>
   void shoot(const double* q0, const double* w0, double h);
   void propagate(const double* q0, const double* w0, double h, const Pass& pass);
   void accumulate(int node, double h, Jet2& S);
   void add_work(double weight, const Jet2* v);
   void gather(const Pass& pass);
+  template <int N>
   void first_derivatives();
   void second_derivatives(const Pass& pass);
+  template <int N>
   void residual(Target target, const double* data);
+  template <int N>
   struct Equations;  // the shooting equations as a NewtonSolver system
+  template <int N>
   void solve(const double* q0, double h, Target target, const double* data);
+  template <int N>
   void warm_start(bool continues);
+  template <int N>
   void record_correction(double h);
   bool type_2() const { return form_ == ShootingForm::type_2; }
   // The boundary quantity is the offset q^n - (q0 + eta): a vector space, Type I forms.
