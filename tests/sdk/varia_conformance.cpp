@@ -2,12 +2,13 @@
 // effect and force conforms; an effect whose gradient is 1.5 times V's derivative
 // (tests/fault_plugins/wrong_effect_gradient.cpp) is refused, exit 1, with the Taylor test's
 // slope; and the suites, called as functions, refuse a force with a wrong Jacobian entry and a
-// Lagrangian whose own Stormer-Verlet steps are not the recurrence's.
+// Lagrangian whose own Stormer-Verlet steps or shots are not the recurrence's.
 #include <doctest/doctest.h>
 
 #include <cstdio>
 #include <filesystem>
 #include <string>
+#include <vector>
 
 #include "varia/sdk/conformance/force.hpp"
 #include "varia/sdk/conformance/lagrangian.hpp"
@@ -92,7 +93,71 @@ class Oscillator final : public varia::Lagrangian {
   bool wrong_;
 };
 
+// The oscillator L = v^2/2 - q^2/2 on R^1, written by hand (no SDK), that runs the shooting
+// construction's shots itself (explicit_shot.hpp with its own model). `right` as written;
+// `unread` then writes other numbers into the Hessians' block in eta x eta, which no one reads
+// (Lagrangian::shoot); `wrong` adds 1e-9 to the end offset's second derivative in (eta, w0).
+class ShootingOscillator final : public varia::Lagrangian {
+ public:
+  enum class Shots { right, unread, wrong };
+  explicit ShootingOscillator(Shots shots) : shots_(shots) {}
+  int position_size() const noexcept override { return 1; }
+  int velocity_size() const noexcept override { return 1; }
+  varia::Status evaluate(const double* q, const double* v, double* value, double* gradient,
+                         double* hessian) noexcept override {
+    if (value != nullptr) *value = 0.5 * (v[0] * v[0] - q[0] * q[0]);
+    if (gradient != nullptr) gradient[0] = -q[0], gradient[1] = v[0];
+    if (hessian != nullptr) hessian[0] = -1.0, hessian[1] = hessian[2] = 0.0, hessian[3] = 1.0;
+    return nullptr;
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    mass[0] = 1.0;
+    return true;
+  }
+  bool evaluates_at_jets() const noexcept override { return true; }
+  varia::Status gradient_jet(const varia::Jet2* q, const varia::Jet2* v, varia::Jet2* value,
+                             varia::Jet2* gradient) noexcept override {
+    if (value != nullptr) *value = 0.5 * (v[0] * v[0] - q[0] * q[0]);
+    gradient[0] = -q[0];
+    gradient[1] = v[0];
+    return nullptr;
+  }
+  bool runs_shots(const varia::ShotPlan& plan) const noexcept override { return plan.n == 1; }
+  varia::Status shoot(const varia::ShotPlan& plan, const double* q0, const double* w0, double h, varia::Jet2* action,
+                      varia::Jet2* offsets) noexcept override {
+    std::vector<varia::Jet2> work(varia::shot_workspace(plan));
+    varia::explicit_shot(plan, q0, w0, h, *action, offsets, work.data(),
+                         [](const varia::Jet2* q, const varia::Jet2* v, varia::Jet2* L, varia::Jet2* Lq) {
+                           if (L != nullptr) *L = 0.5 * (v[0] * v[0] - q[0] * q[0]);
+                           Lq[0] = -q[0];
+                         });
+    if (shots_ == Shots::unread) action->hessian(0, 0) = 12.5, offsets[0].hessian(0, 0) = -3.0;
+    if (shots_ == Shots::wrong) offsets[0].hessian(0, 1) += 1e-9, offsets[0].hessian(1, 0) += 1e-9;
+    return nullptr;
+  }
+
+ private:
+  Shots shots_;
+};
+
 }  // namespace
+
+TEST_CASE("the Lagrangian suite refuses a plugin whose own shots are off by 1e-9 in a second derivative that the "
+          "shooting Newton reads, and accepts it with its shots right or with other numbers where nothing reads") {
+  using Shots = ShootingOscillator::Shots;
+  std::mt19937 engine(13);
+  for (const Shots shots : {Shots::right, Shots::unread}) {
+    ShootingOscillator oscillator(shots);
+    const auto accepted = varia::sdk::conformance::check_lagrangian(oscillator, engine, 5);
+    const std::string first_failure = accepted.empty() ? std::string() : accepted.list()[0];
+    CAPTURE(first_failure);
+    CHECK(accepted.empty());
+  }
+  ShootingOscillator wrong(Shots::wrong);
+  const auto failures = varia::sdk::conformance::check_lagrangian(wrong, engine, 5);
+  REQUIRE(failures.list().size() == 1);
+  CHECK(failures.list()[0].find("shoot gives S and the offsets") != std::string::npos);
+}
 
 TEST_CASE("the Lagrangian suite refuses a plugin whose own Stormer-Verlet steps kick before the drift, and accepts "
           "the same plugin with the recurrence's order") {

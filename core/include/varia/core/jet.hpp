@@ -10,7 +10,10 @@
 //
 // FixedJet<N> is the same jet over exactly N variables, stored in N + N^2 numbers: the SDK
 // evaluates a model at dual numbers over it when a shooting step's jets are few (jets of the
-// plugin interface are Jet2). Both share one arithmetic (JetArithmetic: the chain rule written
+// plugin interface are Jet2). FixedJet<N, C> carries only the Hessian's last C columns, those in
+// the last C variables (N + N C numbers): the second derivatives that a shooting Newton's
+// Jacobian takes are those in w0, the last n of the 2n variables (eta, w0) (shooting.hpp), and the
+// chain rule gives each column from the same column of its operands. Both share one arithmetic (JetArithmetic: the chain rule written
 // once, as hidden friends, so that a double converts to a constant jet in mixed expressions).
 #pragma once
 
@@ -24,7 +27,7 @@ namespace varia {
 
 inline constexpr int kMaxJetVariables = 12;
 
-template <int N>
+template <int N, int C = N>
 struct FixedJet;
 
 namespace jet {
@@ -102,10 +105,10 @@ J binary(const J& a, const J& b, double f, const Partials& d) {
 // same numbers; the zero ones are skipped as there (0 * an infinite gradient would make NaN). A SVIRK4
 // step of the pendulum, whose model the SDK evaluates at dual numbers over FixedJet<2>: 4.57 ->
 // 3.80 us; the loops above, inlined instead, made it slower (4.68 us).
-template <int N>
-[[gnu::always_inline]] inline FixedJet<N> unary(const FixedJet<N>& a, double f, double d1, double d2) {
-  if (a.constant() || (d1 == 0.0 && d2 == 0.0)) return FixedJet<N>(f);
-  FixedJet<N> r;
+template <int N, int C>
+[[gnu::always_inline]] inline FixedJet<N, C> unary(const FixedJet<N, C>& a, double f, double d1, double d2) {
+  if (a.constant() || (d1 == 0.0 && d2 == 0.0)) return FixedJet<N, C>(f);
+  FixedJet<N, C> r;
   r.is_constant = false;
   r.value = f;
   r.gradient = d1 * a.gradient;
@@ -113,18 +116,18 @@ template <int N>
     r.hessian = d1 * a.hessian;
     return r;
   }
-  for (int j = 0; j < N; ++j) {
-    const double c = d2 * a.gradient[j];
+  for (int j = 0; j < C; ++j) {
+    const double c = d2 * a.gradient[N - C + j];
     for (int i = 0; i < N; ++i) r.hessian(i, j) = d1 * a.hessian(i, j) + c * a.gradient[i];
   }
   return r;
 }
-template <int N>
-[[gnu::always_inline]] inline FixedJet<N> binary(const FixedJet<N>& a, const FixedJet<N>& b, double f,
-                                                const Partials& d) {
+template <int N, int C>
+[[gnu::always_inline]] inline FixedJet<N, C> binary(const FixedJet<N, C>& a, const FixedJet<N, C>& b, double f,
+                                                   const Partials& d) {
   if (a.constant()) return unary(b, f, d.b, d.bb);
   if (b.constant()) return unary(a, f, d.a, d.aa);
-  FixedJet<N> r;
+  FixedJet<N, C> r;
   r.is_constant = false;
   r.value = f;
   r.gradient = d.a * a.gradient + d.b * b.gradient;
@@ -137,9 +140,10 @@ template <int N>
     u[i] = d.aa * a.gradient[i] + d.ab * b.gradient[i];
     w[i] = d.ab * a.gradient[i] + d.bb * b.gradient[i];
   }
-  for (int j = 0; j < N; ++j)
+  for (int j = 0; j < C; ++j)
     for (int i = 0; i < N; ++i)
-      r.hessian(i, j) = d.a * a.hessian(i, j) + d.b * b.hessian(i, j) + u[i] * a.gradient[j] + w[i] * b.gradient[j];
+      r.hessian(i, j) =
+          d.a * a.hessian(i, j) + d.b * b.hessian(i, j) + u[i] * a.gradient[N - C + j] + w[i] * b.gradient[N - C + j];
   return r;
 }
 
@@ -288,23 +292,31 @@ inline void add_scaled(Jet2& r, double c, const Jet2& x) {
 // them took a quarter of a SVIRK4 step (issue #19: 5.15 -> 3.98 us a step of the pendulum). Every
 // use assigns first (valgrind's memcheck finds no read of one on the shooting and Lie group
 // scenes); FixedJet(0.0) is the zero jet.
-template <int N>
-struct FixedJet : JetArithmetic<FixedJet<N>> {
+template <int N, int C>
+struct FixedJet : JetArithmetic<FixedJet<N, C>> {
+  static_assert(C >= 1 && C <= N);
   FixedJet() {}  // NOLINT: uninitialized, as a double
   FixedJet(double constant)  // NOLINT: constants convert implicitly
       : value(constant),
         gradient(Eigen::Matrix<double, N, 1>::Zero()),
-        hessian(Eigen::Matrix<double, N, N>::Zero()),
+        hessian(Eigen::Matrix<double, N, C>::Zero()),
         is_constant(true) {}
-  // Jet2 `jet` of N variables (or a constant) and back.
+  // Jet2 `jet` of N variables (or a constant) and back, written into `jet` in place. With C < N,
+  // to_jet2 fills the Hessian's rows in the last C variables by its symmetry and leaves the block
+  // in the first N - C variables zero: that block is not carried.
   explicit FixedJet(const Jet2& jet) : FixedJet(jet.value) {
-    if (!jet.constant()) gradient = jet.gradient, hessian = jet.hessian, is_constant = false;
+    if (!jet.constant()) gradient = jet.gradient, hessian = jet.hessian.rightCols(C), is_constant = false;
   }
-  Jet2 to_jet2() const {
-    Jet2 jet(value);
+  void to_jet2(Jet2& jet) const {
+    jet.value = value;
     jet.gradient = gradient;
-    jet.hessian = hessian;
-    return jet;
+    if constexpr (C == N) {
+      jet.hessian = hessian;
+    } else {
+      jet.hessian.setZero(N, N);
+      jet.hessian.rightCols(C) = hessian;
+      jet.hessian.bottomLeftCorner(C, N - C) = hessian.topRows(N - C).transpose();
+    }
   }
   // The independent variable `index` of `count` (= N), at `x`.
   static FixedJet variable(double x, int /*count*/, int index) {
@@ -318,7 +330,7 @@ struct FixedJet : JetArithmetic<FixedJet<N>> {
 
   double value;
   Eigen::Matrix<double, N, 1> gradient;
-  Eigen::Matrix<double, N, N> hessian;
+  Eigen::Matrix<double, N, C> hessian;  // columns N - C .. N - 1 of the Hessian
   // Made from a double, with zero derivatives: the chain rule then takes the other operand alone, as
   // for a constant Jet2 (a dual number's seeds over jets are constants). Code that writes the
   // derivatives of a jet made from a double clears it.
@@ -326,8 +338,8 @@ struct FixedJet : JetArithmetic<FixedJet<N>> {
 };
 
 // r += c x in place, as for Jet2 (the same numbers).
-template <int N>
-inline void add_scaled(FixedJet<N>& r, double c, const FixedJet<N>& x) {
+template <int N, int C>
+inline void add_scaled(FixedJet<N, C>& r, double c, const FixedJet<N, C>& x) {
   r.value += c * x.value;
   if (x.constant()) return;
   r.gradient += c * x.gradient;
@@ -356,8 +368,8 @@ struct JetNumTraits : GenericNumTraits<double> {
 };
 template <>
 struct NumTraits<varia::Jet2> : JetNumTraits<varia::Jet2> {};
-template <int N>
-struct NumTraits<varia::FixedJet<N>> : JetNumTraits<varia::FixedJet<N>> {};
+template <int N, int C>
+struct NumTraits<varia::FixedJet<N, C>> : JetNumTraits<varia::FixedJet<N, C>> {};
 
 template <typename BinaryOp>
 struct ScalarBinaryOpTraits<varia::Jet2, double, BinaryOp> {
@@ -367,13 +379,13 @@ template <typename BinaryOp>
 struct ScalarBinaryOpTraits<double, varia::Jet2, BinaryOp> {
   using ReturnType = varia::Jet2;
 };
-template <int N, typename BinaryOp>
-struct ScalarBinaryOpTraits<varia::FixedJet<N>, double, BinaryOp> {
-  using ReturnType = varia::FixedJet<N>;
+template <int N, int C, typename BinaryOp>
+struct ScalarBinaryOpTraits<varia::FixedJet<N, C>, double, BinaryOp> {
+  using ReturnType = varia::FixedJet<N, C>;
 };
-template <int N, typename BinaryOp>
-struct ScalarBinaryOpTraits<double, varia::FixedJet<N>, BinaryOp> {
-  using ReturnType = varia::FixedJet<N>;
+template <int N, int C, typename BinaryOp>
+struct ScalarBinaryOpTraits<double, varia::FixedJet<N, C>, BinaryOp> {
+  using ReturnType = varia::FixedJet<N, C>;
 };
 
 }  // namespace Eigen

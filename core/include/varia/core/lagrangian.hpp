@@ -61,7 +61,9 @@ class Lagrangian : public PluginObject {
   // jets of the 2n variables x = (eta, w0), from one call instead of one a stage and a node.
   // runs_shots(plan) says whether the plugin takes that plan (its n and number of stages); the
   // numbers must be those of explicit_shot with dL/dq from gradient_jet (the conformance suite
-  // checks it). ABI 14.
+  // checks it). The Hessians need only their columns in w0, which are all that the shooting
+  // Newton's Jacobian reads (shooting.hpp); the SDK carries only those (FixedJet<2n, n>) and leaves
+  // the block in eta x eta zero. ABI 14.
   virtual bool runs_shots(const ShotPlan& /*plan*/) const noexcept { return false; }
   virtual Status shoot(const ShotPlan& /*plan*/, const double* /*q0*/, const double* /*w0*/, double /*h*/,
                        Jet2* /*action*/, Jet2* /*offsets*/) noexcept {

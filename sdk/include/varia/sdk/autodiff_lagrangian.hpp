@@ -269,8 +269,9 @@ class AutodiffLagrangian : public Lagrangian {
   }
 #pragma GCC diagnostic pop
 
-  // A shot at n = N (jets of 2N variables, FixedJet): the recurrence of explicit_shot.hpp with the
-  // model inlined (flatten) at dual numbers over the jets in the N directions of q, which give L
+  // A shot at n = N (jets of 2N variables carrying their Hessians' N columns in w0, FixedJet<2N, N>:
+  // those that the shooting Newton reads): the recurrence of explicit_shot.hpp at the fixed size N
+  // with the model inlined (flatten) at dual numbers over the jets in the N directions of q, which give L
   // and dL/dq together (the velocities' directions, which the field of a constant mass matrix does
   // not use, are not taken). The model reads only the first N inputs of its vectors (as at_fixed_jets).
 #pragma GCC diagnostic push
@@ -279,12 +280,12 @@ class AutodiffLagrangian : public Lagrangian {
   template <int N>
   [[gnu::noinline, gnu::flatten]] void fixed_shot(const ShotPlan& plan, const double* q0, const double* w0, double h,
                                                   Jet2* action, Jet2* offsets) const {
-    using J = FixedJet<2 * N>;
+    using J = FixedJet<2 * N, N>;  // the Hessians' columns in w0 only (Lagrangian::shoot)
     using D = JetDual<N, J>;
     std::array<J, 10 * N + 2 * N * kMaxShotStages> work;
     std::array<J, N> end;
     J S;
-    explicit_shot(plan, q0, w0, h, S, end.data(), work.data(), [&](const J* q, const J* v, J* L, J* Lq) {
+    explicit_shot<N>(plan, q0, w0, h, S, end.data(), work.data(), [&](const J* q, const J* v, J* L, J* Lq) {
       Vec<D> qd(N), vd(N);
       for (int r = 0; r < N; ++r) {
         qd(r).value() = q[r];
@@ -298,8 +299,8 @@ class AutodiffLagrangian : public Lagrangian {
       if (L != nullptr) *L = result.value();
       for (int r = 0; r < N; ++r) Lq[r] = result.derivatives()(r);
     });
-    *action = S.to_jet2();
-    for (int r = 0; r < N; ++r) offsets[r] = end[r].to_jet2();
+    S.to_jet2(*action);
+    for (int r = 0; r < N; ++r) end[r].to_jet2(offsets[r]);
   }
 #pragma GCC diagnostic pop
 
@@ -323,8 +324,8 @@ class AutodiffLagrangian : public Lagrangian {
     FixedJet<N> fixed_value;
     for (int i = 0; i < m_ + n_; ++i) inputs[i] = FixedJet<N>(at(q, v, m_, i));
     at_jets(inputs.data(), inputs.data() + m_, value != nullptr ? &fixed_value : nullptr, outputs.data());
-    if (value != nullptr) *value = fixed_value.to_jet2();
-    for (int i = 0; i < m_ + n_; ++i) gradient[i] = outputs[i].to_jet2();
+    if (value != nullptr) fixed_value.to_jet2(*value);
+    for (int i = 0; i < m_ + n_; ++i) outputs[i].to_jet2(gradient[i]);
   }
   // At jets J: one pass of forward mode over every number of (q, v) up to two of them, else one
   // per block of kJetDirections.
