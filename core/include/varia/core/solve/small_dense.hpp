@@ -5,7 +5,7 @@
 // a large product: on the 1-DOF pendulum the shooting step's two factorizations and three solves
 // took a sixth of the step (issue #19). A singular A gives non-finite solutions in either case;
 // the callers' solves check their residuals. Arguments whose size is fixed at compile time take
-// fixed-size code (the shooting step at n <= 3, shooting.cpp).
+// fixed-size code (the shooting step at n <= 4, shooting.cpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -34,10 +34,9 @@ class SmallDenseSolver {
       }
     }
   }
-  // x = A^{-1} b, b a vector or a matrix (x distinct from b, of b's size). For n <= 4 the product
-  // by plain loops: Eigen's product of dynamic matrices chooses its kernel at run time, which
-  // costs more than these few flops.
-  // b of a row count fixed at compile time (n <= 4): a fixed-size product.
+  // x = A^{-1} b, b a vector or a matrix (x distinct from b, of b's size). For n <= 4 a fixed-size
+  // product where b's row count is fixed at compile time, else plain loops: Eigen's product of
+  // dynamic matrices chooses its kernel at run time, which costs more than these few flops.
   template <class Rhs, class Result>
   void solve(const Rhs& b, Result& x) const {
     constexpr int N = Rhs::RowsAtCompileTime;
