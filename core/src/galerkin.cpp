@@ -80,11 +80,13 @@ LagrangeBasis::LagrangeBasis(const std::vector<double>& times, const Quadrature&
   for (int i = 0; i < r; ++i) lagrange(times, quadrature.nodes()[i], phi.col(i).data(), dphi.col(i).data());
 }
 
-Eigen::VectorXd LagrangeBasis::at(double tau) const {
-  Eigen::VectorXd l(control_times.size());
-  lagrange<double>(control_times, tau, l.data(), nullptr);
+Eigen::VectorXd lagrange_basis_at(const std::vector<double>& times, double tau) {
+  Eigen::VectorXd l(times.size());
+  lagrange<double>(times, tau, l.data(), nullptr);
   return l;
 }
+
+Eigen::VectorXd LagrangeBasis::at(double tau) const { return lagrange_basis_at(control_times, tau); }
 
 GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian,
                                                        Quadrature& quadrature,

@@ -57,6 +57,9 @@ struct LagrangeBasis {
   std::vector<double> control_times;
 };
 
+// l_nu(tau), nu = 0..times.size() - 1, of the Lagrange basis through the distinct `times`.
+Eigen::VectorXd lagrange_basis_at(const std::vector<double>& times, double tau);
+
 // Equispaced control times d_nu = nu / s.
 std::vector<double> equispaced_control_times(int degree);
 

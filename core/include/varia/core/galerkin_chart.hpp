@@ -67,14 +67,17 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
  private:
   // S (also kept in action_) and, in gradient_ and (with_hessian) hessian_, its derivatives in (eta, xi^1, ..., xi^s)
   // (blocks of n numbers; block 0 is eta) for the control points in xi_ and the base point q0.
-  double action(const double* q0, double h, bool with_hessian = true);
+  // Without `with_value` S is not wanted (a step's equations need only its derivatives), and for
+  // a constant mass matrix in the reduced form the nodes then ask the plugin for nothing:
+  // dl/dOmega = M Omega.
+  double action(const double* q0, double h, bool with_hessian = true, bool with_value = true);
   // The kernels below are templates on the group's dimension N and point size M, fixed for the
   // groups listed in choose_kernels() (SO(3), SE(3)) and Eigen::Dynamic for any other: one piece
   // of code, instantiated once per size and chosen once, at construction.
   void choose_kernels();
   // Adds quadrature node i: L at the chart curve and the chain rule through the chart's jets.
   template <int N, int M>
-  double add_node(const double* q0, int i, double h, bool with_hessian);
+  double add_node(const double* q0, int i, double h, bool with_hessian, bool with_value);
   // dexp_{sign w} (= d velocity / d xi_dot at xi = -sign w) into dexp_, its inverse transpose,
   // and (with_derivatives) its derivatives in (sign w)_l (one n x n matrix each), from the
   // manifold's chart at jets.
@@ -84,7 +87,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   // and its Jacobian in the unknowns.
   template <int N>
   void step_equations(const double* p0, bool with_jacobian = true);
-  double (LieGroupGalerkinDiscreteLagrangian::*add_node_)(const double*, int, double, bool) = nullptr;
+  double (LieGroupGalerkinDiscreteLagrangian::*add_node_)(const double*, int, double, bool, bool) = nullptr;
   void (LieGroupGalerkinDiscreteLagrangian::*dexp_with_derivatives_)(const double*, const double*, double, bool) = nullptr;
   void (LieGroupGalerkinDiscreteLagrangian::*step_equations_)(const double*, bool) = nullptr;
   struct Equations;  // those equations as a NewtonSolver system
@@ -99,15 +102,19 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
     double bound;                    // the error constant E_k
   };
   static GaussRule gauss_legendre(int k);
-  // True when the guess continues the last step's curve (a guess within O(h^{s+1})).
+  // True when the guess continues the last steps' curve (see the .cpp).
   bool warm_start(const double* q0, const double* p0, double h);
+  auto previous() { return history_.rightCols(s_ + 1); }  // the last step's control points
   void check(Status status) const;
 
   Manifold& manifold_;
   LagrangianEvaluator lagrangian_;
   LagrangeBasis basis_;
   Eigen::VectorXd weights_;
-  Eigen::MatrixXd extrapolation_;  // l_mu(1 + d_nu): the last step's curve continued
+  // The warm start's extrapolations to the times 1 + d_nu: of the last step's curve (l_mu(1 + d_nu),
+  // (s+1) x (s+1)), and of the polynomial through the last two steps' control points
+  // ((2s+1) x (s+1): the step before's d_mu - 1, mu < s, then the last's d_mu).
+  Eigen::MatrixXd extrapolation_, extrapolation_two_;
   SolverOptions options_;
   NewtonSolver solver_;
   SolverStatistics statistics_;
@@ -116,7 +123,11 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   int m_, n_, s_;
   // Workspace, sized once: a step allocates nothing.
   Eigen::MatrixXd xi_;        // n x (s+1) control points in the chart, column 0 = 0
-  Eigen::MatrixXd previous_;  // the last step's control points
+  // The last two steps' control points in the last step's chart: the step before's xi^0..xi^{s-1}
+  // (when two_steps_back_), then the last step's xi^0..xi^s (previous_, the last s+1 columns).
+  Eigen::MatrixXd history_;
+  Eigen::MatrixXd earlier_;  // the last step's xi^0..xi^{s-1} in this step's chart (the next history)
+  bool two_steps_back_ = false;
   Eigen::VectorXd previous_base_, last_end_, last_p_;  // the last step's g0, g1 and p1
   // Compensated sums g1 = g0 + (g1 - g0), p1 = p0 + (p1 - p0) across steps (compensated.hpp):
   // the running compensations and the increments.
