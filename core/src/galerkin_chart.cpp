@@ -329,9 +329,10 @@ void LieGroupGalerkinDiscreteLagrangian::step_equations(const double* p0, bool w
 // The step's equations [p0 + D1 L_d; dS/dxi^1..s-1] (evaluate: the internal ones) in the control
 // points xi^1..xi^unknowns, as a system for NewtonSolver (solve/newton.hpp), with the exact
 // Jacobian, or (simplified) with the Jacobian at the first iterate kept for the whole solve
-// (simplified Newton, solve/newton.hpp): from the last step's curve continued, the iterate is
-// within O(h^{s+1}) of the solution, and the iteration contracts by about that much per update,
-// at a fraction of the cost of an update (no Hessians of the chart and the Lagrangian).
+// (simplified Newton, solve/newton.hpp): from the last steps' curve continued (warm_start), the
+// iterate is within O(h^(s+1)) of the solution (O(h^(2s+1)) once two steps are behind it), and
+// the iteration contracts by about that much per update, at a fraction of the cost of an update
+// (no Hessians of the chart and the Lagrangian).
 struct LieGroupGalerkinDiscreteLagrangian::Equations {
   LieGroupGalerkinDiscreteLagrangian& g;
   const double* q0;
