@@ -7,7 +7,7 @@
 //      pendulum plugin's exact solution): each method at the fewest steps that reach it; varia's
 //      best Galerkin composition against symplectic_rkn_sb3a_mclachlan, and against
 //      runge_kutta_dopri5 with the tolerance tuned to the same error.
-// Times are the fastest of kRepeats runs of the stepping loop alone.
+// Times are the fastest of repeated runs of the stepping loop alone (support.hpp: fastest).
 #include <fmt/format.h>
 
 #include <algorithm>

@@ -19,8 +19,12 @@ Exact exact_at(host::Assembly& pendulum, double t) {
 double error_of(const Exact& exact, double q, double p) { return std::max(std::abs(q - exact.q), std::abs(p - exact.p)); }
 
 double fastest(const std::function<double()>& run) {
-  double best = run();
-  for (int r = 1; r < kRepeats; ++r) best = std::min(best, run());
+  double best = run(), total = best;
+  for (int r = 1; r < kRepeats || total < kMinSeconds; ++r) {
+    const double seconds = run();
+    best = std::min(best, seconds);
+    total += seconds;
+  }
   return best;
 }
 

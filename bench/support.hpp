@@ -19,7 +19,12 @@
 namespace varia::bench {
 
 inline constexpr double kQ0 = 1.3, kT = 100.0;
+// A timed measurement is the fastest of at least kRepeats runs spanning at least kMinSeconds, on
+// either side: on this virtual machine a window of some 0.1 s now and then runs everything about
+// 1.4x slower (seen on varia's side and on GNI's), and five runs of a short integration (0.4 ms)
+// fit inside one.
 inline constexpr int kRepeats = 5;
+inline constexpr double kMinSeconds = 0.25;
 inline constexpr long kMaxSteps = 4'000'000;
 
 // What one method costs at one setting.
@@ -37,7 +42,8 @@ struct Exact {
 Exact exact_at(host::Assembly& pendulum, double t);
 double error_of(const Exact& exact, double q, double p);
 
-// The fastest of kRepeats calls of run(), which returns the seconds it measured.
+// The fastest of calls of run(), which returns the seconds it measured: at least kRepeats calls,
+// and as many more as make their seconds add up to kMinSeconds.
 double fastest(const std::function<double()>& run);
 
 template <class F>
@@ -65,7 +71,7 @@ nlohmann::json galerkin_method(int degree, const std::string& rule, int points);
 std::vector<VariaMethod> galerkin_candidates(host::Registry& registry);
 
 // `steps` steps of the stepping loop alone (host::run_timed, the loop `varia cost` times) over
-// [0, kT]; with `timed`, seconds are the fastest of kRepeats runs. A step size too large for
+// [0, kT]; with `timed`, seconds are the fastest of repeated runs (fastest). A step size too large for
 // Newton's method counts as not reaching any error (error infinite).
 Measure run_varia(VariaMethod& m, long steps, const Exact& exact, bool timed);
 
@@ -75,7 +81,7 @@ Measure run_varia(VariaMethod& m, long steps, const Exact& exact, bool timed);
 Measure fewest_steps(const std::function<Measure(long, bool)>& run, double target);
 
 // boost::odeint's velocity_verlet on the pendulum problem, `steps` steps over [0, kT], counting
-// force evaluations; with `timed`, seconds are the fastest of kRepeats runs.
+// force evaluations; with `timed`, seconds are the fastest of repeated runs (fastest).
 using State1 = std::array<double, 1>;
 struct PendulumForce {  // -sin q (= dp/dt), counting its calls
   long* calls;
