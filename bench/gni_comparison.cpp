@@ -134,8 +134,8 @@ Measure gni_measure(const std::string& kind, int method, long steps, const Exact
 
 // ---- varia --------------------------------------------------------------------------------------
 
-// The fastest of repeated runs (support.hpp: fastest) of the scene through `varia run`'s driver (nothing written): its
-// wall_seconds.
+// The fastest of repeated runs (support.hpp: fastest) of the scene through `varia run`'s driver
+// (nothing written): its wall_seconds.
 double run_seconds(varia::host::Registry& registry, VariaMethod& m) {
   varia::host::RunOptions options;
   options.quiet = true;
@@ -202,8 +202,9 @@ void time_to_error(std::vector<VariaMethod>& candidates, const Exact& exact) {
     const Measure &v = best_of(varia_rows), &g = best_of(gni_rows);
     rows.push_back({fmt::format("time to error {:.0e}, each side's best", target), ms_of(v), ms_of(g),
                     v.seconds / g.seconds, 1.5});
-    std::string runs = fmt::format("error {:.0e}, fewest steps (to 2%) and the fastest of at least {} runs spanning {} s:", target,
-                                   kRepeats, kMinSeconds);
+    std::string runs = fmt::format(
+        "error {:.0e}, fewest steps (to 2%) and the fastest of at least {} runs spanning {} s:", target, kRepeats,
+        kMinSeconds);
     for (const auto* side : {&varia_rows, &gni_rows})
       for (const Measure& m : *side)
         runs += m.steps < 0 ? fmt::format("\n  {}: not reached within {} steps", m.method, kMaxSteps)

@@ -71,8 +71,8 @@ nlohmann::json galerkin_method(int degree, const std::string& rule, int points);
 std::vector<VariaMethod> galerkin_candidates(host::Registry& registry);
 
 // `steps` steps of the stepping loop alone (host::run_timed, the loop `varia cost` times) over
-// [0, kT]; with `timed`, seconds are the fastest of repeated runs (fastest). A step size too large for
-// Newton's method counts as not reaching any error (error infinite).
+// [0, kT]; with `timed`, seconds are the fastest of repeated runs (fastest). A step size too
+// large for Newton's method counts as not reaching any error (error infinite).
 Measure run_varia(VariaMethod& m, long steps, const Exact& exact, bool timed);
 
 // The fewest steps (to within 2%) whose error is at most `target`, by doubling then bisection

@@ -14,7 +14,8 @@ struct HandRun {
   double q = 0.0, p = 0.0, seconds = 0.0, newton_mean = 0.0;
 };
 
-// `steps` steps of h = kT / steps from (kQ0, 0); seconds are the fastest of repeated runs (support.hpp: fastest).
+// `steps` steps of h = kT / steps from (kQ0, 0); seconds are the fastest of repeated runs
+// (support.hpp: fastest).
 HandRun svirk4_by_hand(long steps);
 
 }  // namespace varia::bench

@@ -185,11 +185,11 @@ double LieGroupGalerkinDiscreteLagrangian::add_node(const double* q0, int i, dou
   // The reduced form needs only the velocity block of L's Hessian, d2l/dOmega2, which a declared
   // constant mass matrix gives without an evaluation (hess_ holds it from the start), and, where
   // l's value is not wanted, only dl/dOmega = M Omega (the chain rule reads no other entry of grad_).
-  const Eigen::Map<const Vector<N>> omega(v_.data(), n);
   double L = 0.0;
   if (constant_mass_ && !with_value)
     Eigen::Map<Vector<N>>(grad_.data() + m, n).noalias() =
-        Eigen::Map<const Matrix<Z, Z>>(hess_.data(), m + n, m + n).template bottomRightCorner<N, N>(n, n) * omega;
+        Eigen::Map<const Matrix<Z, Z>>(hess_.data(), m + n, m + n).template bottomRightCorner<N, N>(n, n) *
+        Eigen::Map<const Vector<N>>(v_.data(), n);
   else
     L = with_hessian && !constant_mass_ ? lagrangian_.hessian(q_.data(), v_.data(), grad_.data(), hess_.data())
                                         : lagrangian_.value_and_gradient(q_.data(), v_.data(), grad_.data());

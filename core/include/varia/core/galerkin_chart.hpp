@@ -124,7 +124,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   // Workspace, sized once: a step allocates nothing.
   Eigen::MatrixXd xi_;        // n x (s+1) control points in the chart, column 0 = 0
   // The last two steps' control points in the last step's chart: the step before's xi^0..xi^{s-1}
-  // (when two_steps_back_), then the last step's xi^0..xi^s (previous_, the last s+1 columns).
+  // (when two_steps_back_), then the last step's xi^0..xi^s (previous(), the last s+1 columns).
   Eigen::MatrixXd history_;
   Eigen::MatrixXd earlier_;  // the last step's xi^0..xi^{s-1} in this step's chart (the next history)
   bool two_steps_back_ = false;
