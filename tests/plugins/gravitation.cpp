@@ -42,7 +42,7 @@ VectorXd gauss(varia::Lagrangian& lagrangian, int s, const VectorXd& q0, const V
   VectorXd q = q0, p = p0, q1(n), p1(n);
   map.advance(q.data(), p.data(), h, steps, q1.data(), p1.data());
   VectorXd state(2 * n);
-  state << q1, p1;
+  state << q, p;  // advance() steps (q, p) in place; (q1, p1) are its workspace
   return state;
 }
 

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <algorithm>
+#include <utility>
 
 #include <Eigen/Core>
 #include <stdexcept>
@@ -59,15 +60,20 @@ class DiscreteHamiltonianMap {
     repeat_steps([this](auto... args) { take_step(args...); }, q, p, t0, h, steps, q1, p1);
   }
   // The loop of take_steps() by `step` (take_step's arguments): a map that overrides take_steps
-  // to step by a non-virtual function passes it here.
+  // to step by a non-virtual function passes it here. The steps go back and forth between (q, p)
+  // and (q1, p1), the state copied once at the end if it is in (q1, p1): a copy a step was two
+  // calls of memmove (issue #19).
   template <class Step>
   void repeat_steps(Step&& step, double* q, double* p, double t0, double h, long steps, double* q1, double* p1) {
-    const int m = point_size(), n = dim();
+    double *from_q = q, *from_p = p, *to_q = q1, *to_p = p1;
     for (long k = 0; k < steps; ++k) {
-      step(q, p, t0 + static_cast<double>(k) * h, h, q1, p1);
-      std::copy_n(q1, m, q);
-      std::copy_n(p1, n, p);
+      step(from_q, from_p, t0 + static_cast<double>(k) * h, h, to_q, to_p);
+      std::swap(from_q, to_q);
+      std::swap(from_p, to_p);
     }
+    if (from_q == q) return;
+    std::copy_n(from_q, point_size(), q);
+    std::copy_n(from_p, dim(), p);
   }
 };
 
