@@ -201,14 +201,18 @@ GalerkinDiscreteLagrangian::AdvanceFunction GalerkinDiscreteLagrangian::explicit
 // iteration's nodes c_j (a zero row for a NaN time).
 Eigen::MatrixXd GalerkinDiscreteLagrangian::extrapolation_to_nodes(const std::vector<double>& times) const {
   const int count = static_cast<int>(times.size()), R = static_cast<int>(iteration_nodes_.size());
-  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(count, R);
+  std::vector<double> known;
+  std::vector<int> rows;
   for (int m = 0; m < count; ++m)
-    for (int j = 0; j < R && !std::isnan(times[m]); ++j) {
-      double l = 1.0;
-      for (int k = 0; k < count; ++k)
-        if (k != m && !std::isnan(times[k])) l *= (nodes_[iteration_nodes_[j]] - times[k]) / (times[m] - times[k]);
-      E(m, j) = l;
+    if (!std::isnan(times[m])) {
+      known.push_back(times[m]);
+      rows.push_back(m);
     }
+  Eigen::MatrixXd E = Eigen::MatrixXd::Zero(count, R);
+  for (int j = 0; j < R; ++j) {
+    const Eigen::VectorXd l = lagrange_basis_at(known, nodes_[iteration_nodes_[j]]);
+    for (std::size_t k = 0; k < rows.size(); ++k) E(rows[k], j) = l[static_cast<Eigen::Index>(k)];
+  }
   return E;
 }
 
