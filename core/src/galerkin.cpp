@@ -192,7 +192,8 @@ GalerkinDiscreteLagrangian::AdvanceFunction GalerkinDiscreteLagrangian::explicit
   inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
   kick_.resize(n_, n_);
   verlet_start_.resize(3 * n_);
-  plugin_runs_steps_ = lagrangian_.plugin().runs_verlet_steps();
+  kernel::StormerVerletSteps verlet;
+  plugin_runs_steps_ = lagrangian_.plugin().offers(kernel::call(verlet));
   return for_dimension(
       n_, [](auto N) -> AdvanceFunction { return &GalerkinDiscreteLagrangian::explicit_advance<decltype(N)::value>; });
 }
@@ -311,7 +312,7 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
 // (bench/README.md). The increment and dL/dq are kept for the next call: one that continues from
 // this one's output (q, p and h as left) takes the same steps as one call for both, to the bit,
 // and evaluates no gradient at q.
-// Where the plugin runs the steps itself (Lagrangian::verlet_steps: the SDK's autodiff
+// Where the plugin runs the steps itself (kernel::StormerVerletSteps: the SDK's autodiff
 // Lagrangians), the loop crosses the plugin boundary once for all the steps, with the model's
 // dL/dq inlined in it: the same recurrence, the same numbers. Else, or to find the step whose
 // gradient is not finite, the loop here calls the plugin once a step.

@@ -10,8 +10,9 @@ namespace varia {
 namespace {
 
 LagrangianEvaluator& checked(const Manifold& manifold, LagrangianEvaluator& lagrangian) {
-  if (manifold.is_vector_space())
-    throw std::invalid_argument("the Euler-Poincare field is for a Lie group, and the manifold is a vector space");
+  if (manifold.structure() != ManifoldStructure::lie_group)
+    throw std::invalid_argument(std::string("the Euler-Poincare field is for a Lie group, and the manifold is a ") +
+                                structure_name(manifold.structure()));
   if (lagrangian.position_size() != manifold.point_size() || lagrangian.velocity_size() != manifold.dim())
     throw std::invalid_argument("the Lagrangian's sizes (" + std::to_string(lagrangian.position_size()) + " + " +
                                 std::to_string(lagrangian.velocity_size()) + ") do not match the manifold's (" +

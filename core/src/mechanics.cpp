@@ -5,6 +5,8 @@
 #include <cmath>
 #include <string>
 
+#include "varia/core/explicit_shot.hpp"
+
 namespace varia {
 
 LagrangianEvaluator::LagrangianEvaluator(Lagrangian& lagrangian)
@@ -92,7 +94,8 @@ void LagrangianEvaluator::gradient_jet(const Jet2* q, const Jet2* v, Jet2* value
 
 void LagrangianEvaluator::shoot(const ShotPlan& plan, const double* q0, const double* w0, double h, Jet2* action,
                                 Jet2* offsets) {
-  check(lagrangian_, lagrangian_.shoot(plan, q0, w0, h, action, offsets), "Lagrangian shot");
+  kernel::ExplicitShot shot{&plan, q0, w0, h, action, offsets};
+  check(lagrangian_, lagrangian_.run(kernel::call(shot)), "Lagrangian shot");
   counters_.hessian += shot_evaluations(plan);
   bool finite = isfinite(*action);
   for (int r = 0; r < plan.n; ++r) finite = finite && isfinite(offsets[r]);
@@ -100,7 +103,8 @@ void LagrangianEvaluator::shoot(const ShotPlan& plan, const double* q0, const do
 }
 
 bool LagrangianEvaluator::verlet_steps(double* q, double* d, double* f, const double* K, long steps) {
-  check(lagrangian_, lagrangian_.verlet_steps(q, d, f, K, steps), "Lagrangian Stormer-Verlet steps");
+  kernel::StormerVerletSteps verlet{q, d, f, K, steps};
+  check(lagrangian_, lagrangian_.run(kernel::call(verlet)), "Lagrangian Stormer-Verlet steps");
   counters_.gradient += steps;
   for (int i = 0; i < n_; ++i)
     if (!std::isfinite(q[i]) || !std::isfinite(d[i]) || !std::isfinite(f[i])) return false;

@@ -158,7 +158,9 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
       start_correction_ == 0.0 && end_correction_ == 0.0 && tableau.stages > 0 && passes_.size() == 1) {
     shot_plan_ = {tableau, static_cast<int>(nodes_.size()), nodes_.data(), weights_.data(), n_,
                   field_->inverse_mass().data()};
-    plugin_shoots_ = lagrangian.runs_shots(shot_plan_);
+    kernel::ExplicitShot shot;
+    shot.plan = &shot_plan_;
+    plugin_shoots_ = lagrangian.offers(kernel::call(shot));
   }
   step_ = manifold_.is_vector_space()
               ? for_dimension(n_, [](auto N) -> StepFunction { return &ShootingDiscreteLagrangian::step_at<decltype(N)::value>; })

@@ -24,6 +24,16 @@ void create_forces(const Scene& scene, Registry& registry, Assembly& a) {
   for (const auto& spec : scene.forces) a.forces.push_back(make_part<Force>(registry, spec, scene, *a.manifold));
 }
 
+// The constructions serve vector spaces and Lie groups (a product of Lie groups is one); a
+// manifold of another structure is refused here, once, for every construction.
+void check_structure_served(const Scene& scene, const Manifold& manifold) {
+  const ManifoldStructure structure = manifold.structure();
+  if (structure == ManifoldStructure::vector_space || structure == ManifoldStructure::lie_group) return;
+  throw InputError(fmt::format(
+      "/system/manifold: the {} manifold is a {}, and the constructions serve vector spaces and Lie groups",
+      scene.manifold.type, structure_name(structure)));
+}
+
 void check_lagrangian_fits(const Scene& scene, const Lagrangian& lagrangian, const Manifold& manifold) {
   if (lagrangian.position_size() == manifold.point_size() && lagrangian.velocity_size() == manifold.dim())
     return;
@@ -117,6 +127,7 @@ Assembly assemble(const Scene& scene, Registry& registry) {
   Assembly a;
   // The manifold first: its sizes go into the context of the others (Rn reads its "dim").
   a.manifold = make_part<Manifold>(registry, scene.manifold, sdk::Context{scene.manifold.type, 0, 0});
+  check_structure_served(scene, *a.manifold);
   check_initial_state(scene, *a.manifold, scene.manifold.type);
   a.lagrangian = lagrangian(scene, registry, *a.manifold);
   check_lagrangian_fits(scene, *a.lagrangian, *a.manifold);

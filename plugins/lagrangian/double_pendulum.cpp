@@ -17,7 +17,7 @@
 
 namespace {
 
-class DoublePendulum final : public varia::sdk::AutodiffLagrangian<DoublePendulum> {
+class DoublePendulum final : public varia::sdk::AutodiffLagrangian<DoublePendulum, 2, 2> {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -45,8 +45,7 @@ class DoublePendulum final : public varia::sdk::AutodiffLagrangian<DoublePendulu
   })json";
 
   DoublePendulum(const nlohmann::json& parameters, const varia::sdk::Context& context)
-      : AutodiffLagrangian(2, 2),
-        m1_(varia::plugins::positive_parameter(parameters, "mass1", 1.0)),
+      : m1_(varia::plugins::positive_parameter(parameters, "mass1", 1.0)),
         m2_(varia::plugins::positive_parameter(parameters, "mass2", 1.0)),
         l1_(varia::plugins::positive_parameter(parameters, "length1", 1.0)),
         l2_(varia::plugins::positive_parameter(parameters, "length2", 1.0)),

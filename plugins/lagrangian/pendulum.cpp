@@ -60,7 +60,7 @@ double wrap(double x) {
   return r == -pi ? pi : r;
 }
 
-class Pendulum final : public varia::sdk::AutodiffLagrangian<Pendulum> {
+class Pendulum final : public varia::sdk::AutodiffLagrangian<Pendulum, 1, 1> {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -86,7 +86,7 @@ class Pendulum final : public varia::sdk::AutodiffLagrangian<Pendulum> {
   })json";
 
   Pendulum(const nlohmann::json& parameters, const varia::sdk::Context& context)
-      : AutodiffLagrangian(1, 1),
+      : AutodiffLagrangian(),
         mass_(varia::plugins::positive_parameter(parameters, "mass", 1.0)),
         length_(varia::plugins::positive_parameter(parameters, "length", 1.0)),
         gravity_(varia::plugins::positive_parameter(parameters, "gravity", 1.0)),

@@ -59,12 +59,11 @@ inline Eigen::Matrix3d random_rotation(unsigned seed, const Eigen::Vector3d* axi
 }
 
 template <class Model>
-class RigidBodyLagrangian : public sdk::AutodiffLagrangian<Model> {
+class RigidBodyLagrangian : public sdk::AutodiffLagrangian<Model, 9, 3> {
  public:
   RigidBodyLagrangian(const nlohmann::json& parameters, const sdk::Context& context,
                       const char* type)
-      : sdk::AutodiffLagrangian<Model>(9, 3),
-        inertia_(vector3_parameter(parameters, "inertia", true, Eigen::Vector3d::Ones())) {
+      : inertia_(vector3_parameter(parameters, "inertia", true, Eigen::Vector3d::Ones())) {
     require_so3(context, type);
   }
 

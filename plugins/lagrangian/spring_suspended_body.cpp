@@ -17,7 +17,7 @@ namespace {
 using varia::plugins::positive_parameter;
 using varia::plugins::vector3_parameter;
 
-class SpringSuspendedBody final : public varia::sdk::AutodiffLagrangian<SpringSuspendedBody> {
+class SpringSuspendedBody final : public varia::sdk::AutodiffLagrangian<SpringSuspendedBody, 12, 6> {
  public:
   static constexpr const char* version = "1.0.0";
   static constexpr const char* parameter_schema = R"json({
@@ -50,8 +50,7 @@ class SpringSuspendedBody final : public varia::sdk::AutodiffLagrangian<SpringSu
   })json";
 
   SpringSuspendedBody(const nlohmann::json& parameters, const varia::sdk::Context& context)
-      : AutodiffLagrangian(12, 6),
-        inertia_(vector3_parameter(parameters, "inertia", true, Eigen::Vector3d::Ones())),
+      : inertia_(vector3_parameter(parameters, "inertia", true, Eigen::Vector3d::Ones())),
         attachment_(vector3_parameter(parameters, "attachment", false, Eigen::Vector3d::UnitZ())),
         anchor_(vector3_parameter(parameters, "anchor", false, Eigen::Vector3d::Zero())),
         mass_(positive_parameter(parameters, "mass", 1.0)),

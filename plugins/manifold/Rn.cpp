@@ -52,7 +52,7 @@ class Rn final : public varia::Manifold {
 
   int point_size() const noexcept override { return n_; }
   int dim() const noexcept override { return n_; }
-  bool is_vector_space() const noexcept override { return true; }
+  varia::ManifoldStructure structure() const noexcept override { return varia::ManifoldStructure::vector_space; }
 
   varia::Status retract(const double* q0, const double* xi, double* q) noexcept override {
     for (int i = 0; i < n_; ++i) q[i] = q0[i] + xi[i];

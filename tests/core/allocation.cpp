@@ -77,8 +77,8 @@ TEST_CASE("allocations are counted: resizing a dynamic vector allocates") {
 }
 
 // The same pendulums not declaring their mass matrix: Newton with the exact Jacobian.
-struct UndeclaredPendulums : Pendulums {
-  using Pendulums::Pendulums;
+struct UndeclaredPendulums : Pendulums<> {
+  using Pendulums<>::Pendulums;
   bool constant_mass_matrix(double*) const noexcept override { return false; }
 };
 

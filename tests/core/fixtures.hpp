@@ -17,7 +17,7 @@ struct FlatSpace : Manifold {
   explicit FlatSpace(int n) : n(n) {}
   int point_size() const noexcept override { return n; }
   int dim() const noexcept override { return n; }
-  bool is_vector_space() const noexcept override { return true; }
+  ManifoldStructure structure() const noexcept override { return ManifoldStructure::vector_space; }
   Status retract(const double* q0, const double* xi, double* q) noexcept override {
     for (int i = 0; i < n; ++i) q[i] = q0[i] + xi[i];
     return nullptr;
@@ -47,27 +47,33 @@ inline FixedRule trapezoid() { return FixedRule({0.0, 1.0}, {0.5, 0.5}, 1); }
 inline FixedRule lobatto3() { return FixedRule({0.0, 0.5, 1.0}, {1.0 / 6, 4.0 / 6, 1.0 / 6}, 3); }
 
 // L = v^2/2 - q^2/2 (unit oscillator) or v^2/2 + cos q (unit pendulum) on R^1.
-struct Oscillator : sdk::AutodiffLagrangian<Oscillator> {
-  Oscillator() : sdk::AutodiffLagrangian<Oscillator>(1, 1) {}
+struct Oscillator : sdk::AutodiffLagrangian<Oscillator, 1, 1> {
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     return 0.5 * v(0) * v(0) - 0.5 * q(0) * q(0);
   }
+  // Refuses the explicit forms (the SDK would read its constant mass matrix off L): the tests take
+  // Newton's paths with it, and declare M where they want the explicit ones (MassOscillator).
+  bool constant_mass_matrix(double* /*mass*/) const noexcept override { return false; }
 };
 
-struct Pendulum : sdk::AutodiffLagrangian<Pendulum> {
-  Pendulum() : sdk::AutodiffLagrangian<Pendulum>(1, 1) {}
+struct Pendulum : sdk::AutodiffLagrangian<Pendulum, 1, 1> {
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     using std::cos;
     return 0.5 * v(0) * v(0) + cos(q(0));
   }
+  // Refuses the explicit forms (the SDK would read its constant mass matrix off L): the tests take
+  // Newton's paths with it, and declare M where they want the explicit ones (SeparablePendulum).
+  bool constant_mass_matrix(double* /*mass*/) const noexcept override { return false; }
 };
 
 // n uncoupled pendulums with masses 1..n, declaring their constant mass matrix: at degree 1 the
-// Galerkin explicit form applies, at a fixed size (n <= 4) or the dynamic size (n > 4).
-struct Pendulums : sdk::AutodiffLagrangian<Pendulums> {
-  explicit Pendulums(int n) : sdk::AutodiffLagrangian<Pendulums>(n, n), n_(n) {}
+// Galerkin explicit form applies, at a fixed size (n <= 4) or the dynamic size (n > 4). With
+// Size given, the model's sizes are known when it is compiled (the SDK's fixed-size duals).
+template <int Size = Eigen::Dynamic>
+struct Pendulums : sdk::AutodiffLagrangian<Pendulums<Size>, Size, Size> {
+  explicit Pendulums(int n = Size) : sdk::AutodiffLagrangian<Pendulums<Size>, Size, Size>(n, n), n_(n) {}
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     using std::cos;
@@ -88,9 +94,8 @@ struct Rotations : sdk::groups::RotationGroup {};
 
 // A top with principal moments J and weight w = m g at the body offset chi (w = 0: the free rigid
 // body): L = 1/2 Omega . J Omega - w e3 . (R chi), R row-major in q.
-struct Top : sdk::AutodiffLagrangian<Top> {
-  Top(Eigen::Vector3d J, double w, Eigen::Vector3d chi)
-      : sdk::AutodiffLagrangian<Top>(9, 3), J(J), w(w), chi(chi) {}
+struct Top : sdk::AutodiffLagrangian<Top, 9, 3> {
+  Top(Eigen::Vector3d J, double w, Eigen::Vector3d chi) : J(J), w(w), chi(chi) {}
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     T L = T(0.0);
@@ -107,6 +112,13 @@ struct Top : sdk::AutodiffLagrangian<Top> {
 };
 
 }  // namespace varia::testing
+
+// The models' derivatives are compiled once, in tests/fixtures.cpp (the test_fixtures library),
+// not in every test file that includes this header.
+extern template class varia::sdk::AutodiffLagrangian<varia::testing::Oscillator, 1, 1>;
+extern template class varia::sdk::AutodiffLagrangian<varia::testing::Pendulum, 1, 1>;
+extern template class varia::sdk::AutodiffLagrangian<varia::testing::Pendulums<>, Eigen::Dynamic, Eigen::Dynamic>;
+extern template class varia::sdk::AutodiffLagrangian<varia::testing::Top, 9, 3>;
 
 namespace varia::testing {
 

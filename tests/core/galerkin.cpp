@@ -178,7 +178,7 @@ TEST_CASE("galerkin advance takes the same steps as step, bit for bit") {
 namespace {
 
 // A Lagrangian seen through evaluate() and its constant mass matrix only: the explicit form then
-// calls the plugin once a step instead of having it run the steps (Lagrangian::verlet_steps).
+// calls the plugin once a step instead of having it run the steps (kernel::StormerVerletSteps).
 struct EvaluateOnly : Lagrangian {
   explicit EvaluateOnly(Lagrangian& inner) : inner(inner) {}
   int position_size() const noexcept override { return inner.position_size(); }
@@ -192,7 +192,7 @@ struct EvaluateOnly : Lagrangian {
 
 }  // namespace
 
-// The explicit form's steps run inside the plugin (the SDK's verlet_steps: one plugin call for all
+// The explicit form's steps run inside the plugin (the SDK's Stormer-Verlet kernel: one plugin call for all
 // of them) are those of the loop that calls the plugin once a step, to the bit, at the fixed sizes
 // and the dynamic one, with the same gradient count; and where a gradient within them is not
 // finite (the wall at q = 1), advance() fails as that loop does, with the same message.
@@ -203,7 +203,8 @@ TEST_CASE("galerkin explicit form run inside the plugin: the steps of one plugin
     FlatSpace space(n);
     Pendulums pendulums(n);
     EvaluateOnly each_step(pendulums);
-    REQUIRE(pendulums.runs_verlet_steps());
+    kernel::StormerVerletSteps verlet;
+    REQUIRE(pendulums.offers(kernel::call(verlet)));
     GalerkinDiscreteLagrangian inside(space, pendulums, rule, equispaced_control_times(1), {});
     GalerkinDiscreteLagrangian outside(space, each_step, rule, equispaced_control_times(1), {});
     Eigen::VectorXd q = Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), p = Eigen::VectorXd::Zero(n), a = q, b = p;

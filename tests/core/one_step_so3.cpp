@@ -135,7 +135,7 @@ TEST_CASE("the one-step construction refuses a manifold that is neither R^n nor 
     Sphere() : FlatSpace(3) {}
     int point_size() const noexcept override { return 3; }
     int dim() const noexcept override { return 2; }
-    bool is_vector_space() const noexcept override { return false; }
+    ManifoldStructure structure() const noexcept override { return ManifoldStructure::homogeneous_space; }
   } sphere;
   Top top(Vector3d(1, 2, 3), 0.0, Vector3d::Zero());
   auto rk = explicit_midpoint();

@@ -22,8 +22,7 @@ struct MassOscillator : Oscillator {
 };
 
 // A planar central force, L = |v|^2/2 + 1/|q|: rotation invariant (SO(2) on R^2).
-struct PlanarKepler : sdk::AutodiffLagrangian<PlanarKepler> {
-  PlanarKepler() : sdk::AutodiffLagrangian<PlanarKepler>(2, 2) {}
+struct PlanarKepler : sdk::AutodiffLagrangian<PlanarKepler, 2, 2> {
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     using std::sqrt;
@@ -37,8 +36,7 @@ struct PlanarKepler : sdk::AutodiffLagrangian<PlanarKepler> {
 
 // The double pendulum (unit masses and lengths): L = v1^2 + 1/2 v2^2 + v1 v2 cos(q1 - q2) + 2 cos q1
 // + cos q2, a configuration-dependent mass matrix, declared as none.
-struct DoublePendulum : sdk::AutodiffLagrangian<DoublePendulum> {
-  DoublePendulum() : sdk::AutodiffLagrangian<DoublePendulum>(2, 2) {}
+struct DoublePendulum : sdk::AutodiffLagrangian<DoublePendulum, 2, 2> {
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     using std::cos;
@@ -97,3 +95,8 @@ inline double fitted_order(const std::vector<double>& h, const std::vector<doubl
 }
 
 }  // namespace varia::testing
+
+// Compiled once, in tests/fixtures.cpp.
+extern template class varia::sdk::AutodiffLagrangian<varia::testing::PlanarKepler, 2, 2>;
+extern template class varia::sdk::AutodiffLagrangian<varia::testing::DoublePendulum, 2, 2>;
+

@@ -104,9 +104,8 @@ namespace {
 // A pendulum of unit mass beside one of mass 1e-9 (a planet beside Pluto): difference steps on the
 // scale of each coordinate measure the symplecticity of both; a unit momentum step moves the light
 // one at 1e9 times its speed, and the defect then measures the nonlinearity of that motion.
-struct HeavyAndLight : sdk::AutodiffLagrangian<HeavyAndLight> {
+struct HeavyAndLight : sdk::AutodiffLagrangian<HeavyAndLight, 2, 2> {
   static constexpr double light = 1e-9;
-  HeavyAndLight() : sdk::AutodiffLagrangian<HeavyAndLight>(2, 2) {}
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     using std::cos;

@@ -7,8 +7,7 @@
 
 namespace varia::testing {
 
-struct Wall : sdk::AutodiffLagrangian<Wall> {
-  Wall() : sdk::AutodiffLagrangian<Wall>(1, 1) {}
+struct Wall : sdk::AutodiffLagrangian<Wall, 1, 1> {
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     using std::sqrt;

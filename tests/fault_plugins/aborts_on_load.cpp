@@ -12,10 +12,6 @@ const int aborted_on_load = (std::abort(), 0);
 class AbortsOnLoad : public varia::test::FaultLagrangian<AbortsOnLoad> {
  public:
   AbortsOnLoad(const nlohmann::json&, const varia::sdk::Context&) { (void)aborted_on_load; }
-  template <class T>
-  T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
-    return oscillator(q, v);
-  }
 };
 
 VARIA_PLUGIN(AbortsOnLoad, lagrangian, fault_abort_on_load)

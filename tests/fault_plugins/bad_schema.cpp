@@ -7,10 +7,6 @@ class BadSchema : public varia::test::FaultLagrangian<BadSchema> {
  public:
   static constexpr const char* parameter_schema = R"({"type": 5})";
   BadSchema(const nlohmann::json&, const varia::sdk::Context&) {}
-  template <class T>
-  T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
-    return oscillator(q, v);
-  }
 };
 
 VARIA_PLUGIN(BadSchema, lagrangian, fault_bad_schema)

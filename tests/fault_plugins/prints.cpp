@@ -23,15 +23,14 @@ const bool chattered_on_load = (chatter("on load"), true);
 class Prints : public varia::test::FaultLagrangian<Prints> {
  public:
   Prints(const nlohmann::json&, const varia::sdk::Context&) { chatter("in the constructor"); }
-  template <class T>
-  T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
+  double evaluation() {
     if (!evaluated_) chatter("in the first evaluation");
     evaluated_ = chattered_on_load;
-    return oscillator(q, v);
+    return 1.0;
   }
 
  private:
-  mutable bool evaluated_ = false;
+  bool evaluated_ = false;
 };
 
 VARIA_PLUGIN(Prints, lagrangian, fault_printf)

@@ -7,10 +7,7 @@
 class ReturnsNan : public varia::test::FaultLagrangian<ReturnsNan> {
  public:
   ReturnsNan(const nlohmann::json&, const varia::sdk::Context&) {}
-  template <class T>
-  T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
-    return oscillator(q, v) * std::numeric_limits<double>::quiet_NaN();
-  }
+  double evaluation() { return std::numeric_limits<double>::quiet_NaN(); }
 };
 
 VARIA_PLUGIN(ReturnsNan, lagrangian, fault_nan)

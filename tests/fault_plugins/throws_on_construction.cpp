@@ -9,10 +9,6 @@ class ThrowsOnConstruction : public varia::test::FaultLagrangian<ThrowsOnConstru
   ThrowsOnConstruction(const nlohmann::json&, const varia::sdk::Context&) {
     throw std::runtime_error("deliberate failure in the constructor");
   }
-  template <class T>
-  T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
-    return oscillator(q, v);
-  }
 };
 
 VARIA_PLUGIN(ThrowsOnConstruction, lagrangian, fault_construct)

@@ -7,10 +7,7 @@
 class ThrowsOnEvaluation : public varia::test::FaultLagrangian<ThrowsOnEvaluation> {
  public:
   ThrowsOnEvaluation(const nlohmann::json&, const varia::sdk::Context&) {}
-  template <class T>
-  T lagrangian(const varia::sdk::Vec<T>&, const varia::sdk::Vec<T>&) const {
-    throw std::runtime_error("deliberate failure in evaluate");
-  }
+  double evaluation() { throw std::runtime_error("deliberate failure in evaluate"); }
 };
 
 VARIA_PLUGIN(ThrowsOnEvaluation, lagrangian, fault_evaluate)

@@ -123,8 +123,7 @@ namespace {
 
 // A double pendulum's L = 1/2 v1^2 + 1/2 v2^2 + v1 v2 cos(q1 - q2) + cos q1 (m + n = 4, cross terms in
 // q and v) and a pendulum's (m + n = 2), with their gradients written out for jet arithmetic.
-struct Coupled : varia::sdk::AutodiffLagrangian<Coupled> {
-  Coupled() : varia::sdk::AutodiffLagrangian<Coupled>(2, 2) {}
+struct Coupled : varia::sdk::AutodiffLagrangian<Coupled, 2, 2> {
   template <class T>
   T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
     using std::cos;

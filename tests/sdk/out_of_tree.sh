@@ -11,6 +11,10 @@ for f in bin/varia bin/varia-conformance include/varia/sdk/plugin.hpp include/va
   lib/cmake/varia/variaConfig.cmake lib/varia/plugins/lagrangian_pendulum.so; do
   test -e "$work/prefix/$f" || { echo "not installed: $f" >&2; exit 1; }
 done
+# Core's internals (the constructions, the driver) are not part of the package.
+for f in include/varia/core/galerkin.hpp include/varia/core/trajectory.hpp include/varia/core/mechanics.hpp; do
+  test ! -e "$work/prefix/$f" || { echo "installed, but internal: $f" >&2; exit 1; }
+done
 cmake -S "$source/examples/out-of-tree-plugin" -B "$work/duffing" -G Ninja \
   -DCMAKE_BUILD_TYPE=Release -DCMAKE_PREFIX_PATH="$work/prefix" >/dev/null
 cmake --build "$work/duffing" >/dev/null

@@ -77,9 +77,15 @@ class Oscillator final : public varia::Lagrangian {
     mass[0] = mass[3] = 1.0, mass[1] = mass[2] = 0.0;
     return true;
   }
-  bool runs_verlet_steps() const noexcept override { return true; }
-  varia::Status verlet_steps(double* q, double* d, double* f, const double* K, long steps) noexcept override {
-    for (long k = 0; k < steps; ++k) {
+  bool offers(const varia::KernelCall& call) const noexcept override {
+    return varia::kernel::arguments<varia::kernel::StormerVerletSteps>(call) != nullptr;
+  }
+  varia::Status run(const varia::KernelCall& call) noexcept override {
+    const auto* verlet = varia::kernel::arguments<varia::kernel::StormerVerletSteps>(call);
+    if (verlet == nullptr) return "not offered";
+    double *q = verlet->q, *d = verlet->d, *f = verlet->f;
+    const double* K = verlet->K;
+    for (long k = 0; k < verlet->steps; ++k) {
       if (wrong_)
         for (int i = 0; i < 2; ++i) d[i] += K[i] * f[0] + K[2 + i] * f[1];
       for (int i = 0; i < 2; ++i) q[i] += d[i], f[i] = -q[i];
@@ -96,7 +102,7 @@ class Oscillator final : public varia::Lagrangian {
 // The oscillator L = v^2/2 - q^2/2 on R^1, written by hand (no SDK), that runs the shooting
 // construction's shots itself (explicit_shot.hpp with its own model). `right` as written;
 // `unread` then writes other numbers into the Hessians' block in eta x eta, which no one reads
-// (Lagrangian::shoot); `wrong` adds 1e-9 to the end offset's second derivative in (eta, w0).
+// (kernel::ExplicitShot); `wrong` adds 1e-9 to the end offset's second derivative in (eta, w0).
 class ShootingOscillator final : public varia::Lagrangian {
  public:
   enum class Shots { right, unread, wrong };
@@ -122,9 +128,16 @@ class ShootingOscillator final : public varia::Lagrangian {
     gradient[1] = v[0];
     return nullptr;
   }
-  bool runs_shots(const varia::ShotPlan& plan) const noexcept override { return plan.n == 1; }
-  varia::Status shoot(const varia::ShotPlan& plan, const double* q0, const double* w0, double h, varia::Jet2* action,
-                      varia::Jet2* offsets) noexcept override {
+  bool offers(const varia::KernelCall& call) const noexcept override {
+    const auto* shot = varia::kernel::arguments<varia::kernel::ExplicitShot>(call);
+    return shot != nullptr && shot->plan != nullptr && shot->plan->n == 1;
+  }
+  varia::Status run(const varia::KernelCall& call) noexcept override {
+    if (!offers(call)) return "not offered";
+    const auto& shot = *varia::kernel::arguments<varia::kernel::ExplicitShot>(call);
+    const varia::ShotPlan& plan = *shot.plan;
+    const double *q0 = shot.q0, *w0 = shot.w0, h = shot.h;
+    varia::Jet2 *action = shot.action, *offsets = shot.offsets;
     std::vector<varia::Jet2> work(varia::shot_workspace(plan));
     varia::explicit_shot(plan, q0, w0, h, *action, offsets, work.data(),
                          [](const varia::Jet2* q, const varia::Jet2* v, varia::Jet2* L, varia::Jet2* Lq) {
@@ -156,7 +169,7 @@ TEST_CASE("the Lagrangian suite refuses a plugin whose own shots are off by 1e-9
   ShootingOscillator wrong(Shots::wrong);
   const auto failures = varia::sdk::conformance::check_lagrangian(wrong, engine, 5);
   REQUIRE(failures.list().size() == 1);
-  CHECK(failures.list()[0].find("shoot gives S and the offsets") != std::string::npos);
+  CHECK(failures.list()[0].find("the explicit shot kernel gives S and the offsets") != std::string::npos);
 }
 
 TEST_CASE("the Lagrangian suite refuses a plugin whose own Stormer-Verlet steps kick before the drift, and accepts "
@@ -169,7 +182,7 @@ TEST_CASE("the Lagrangian suite refuses a plugin whose own Stormer-Verlet steps 
   CHECK(accepted.empty());
   const auto failures = varia::sdk::conformance::check_lagrangian(wrong, engine, 5);
   REQUIRE(failures.list().size() == 1);
-  CHECK(failures.list()[0].find("verlet_steps gives (q, d, f)") != std::string::npos);
+  CHECK(failures.list()[0].find("the Stormer-Verlet steps kernel gives (q, d, f)") != std::string::npos);
 }
 
 TEST_CASE("varia-conformance: every bundled effect and force plugin conforms, by the Taylor tests of its "

@@ -11,7 +11,7 @@
 // step of Psi and one a node.
 //
 // One piece of code for the places that run it: the SDK inside a Lagrangian's plugin with the
-// model inlined (Lagrangian::shoot: the plugin boundary crossed once a shot instead of once a
+// model inlined (kernel::ExplicitShot, kernels.hpp: the plugin boundary crossed once a shot instead of once a
 // stage and a node), and the conformance suite, which checks a plugin's shot against it with the
 // plugin's gradient_jet (sdk/conformance/lagrangian.hpp). Its Runge-Kutta step is the SDK's
 // explicit methods' step (runge_kutta.hpp), at doubles and jets alike.
@@ -22,19 +22,9 @@
 
 #include "varia/core/fixed_size.hpp"
 #include "varia/core/jet.hpp"
+#include "varia/core/kernels.hpp"
 
 namespace varia {
-
-// A Runge-Kutta method's Butcher tableau, viewed: Y_i = y0 + h sum_j a_ij K_j, K_i = f(Y_i),
-// y1 = y0 + h sum_i b_i K_i; a is s x s, column-major. A method that is not an explicit
-// Runge-Kutta method gives stages = 0 (OneStepMethod::explicit_tableau).
-struct RungeKuttaTableau {
-  int stages = 0;
-  const double* a = nullptr;
-  const double* b = nullptr;
-  const double* c = nullptr;
-  double at(int i, int j) const { return a[j * stages + i]; }
-};
 
 // out = start + terms(): a small T (a double, a FixedJet) summed in a local, which stays in
 // registers (summed in place, every term stores and reloads it: the pendulum's SVIRK4 shot, timed
@@ -83,17 +73,6 @@ void explicit_runge_kutta_step(const RungeKuttaTableau& t, double h, int N, cons
   }
   runge_kutta_combination(t, h, N, y0, K, y1);
 }
-
-// What a shot is run with: the explicit method, the quadrature's nodes 0 = c_0 < ... < c_{k-1} = 1
-// with their weights (zero where the rule has no node), and M^{-1}.
-struct ShotPlan {
-  RungeKuttaTableau method;
-  int nodes = 0;
-  const double* node = nullptr;
-  const double* weight = nullptr;
-  int n = 0;                             // the dimension of R^n
-  const double* inverse_mass = nullptr;  // n x n, column-major
-};
 
 // The model's evaluations in a shot: one at every node but a last one of zero weight, and s - 1
 // in every step of Psi.

@@ -251,7 +251,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::VectorXd force_, increment_, last_q_, last_p_;
   bool has_force_ = false;
   // The dense explicit form: K = h^2 (b0 + b1) M^{-1}, whether the plugin runs the steps itself
-  // (Lagrangian::verlet_steps), and (q, h v, dL/dq) where its steps started, to retake them.
+  // (kernel::StormerVerletSteps), and (q, h v, dL/dq) where its steps started, to retake them.
   Eigen::MatrixXd kick_;
   bool plugin_runs_steps_ = false;
   Eigen::VectorXd verlet_start_;

@@ -3,8 +3,8 @@
 // The gradient is [dL/dq (m), dL/dv (n)]; on a Lie group dL/dq is the gradient in the embedding.
 #pragma once
 
-#include "varia/core/explicit_shot.hpp"
 #include "varia/core/jet.hpp"
+#include "varia/core/kernels.hpp"
 #include "varia/core/plugin_object.hpp"
 
 namespace varia {
@@ -44,30 +44,13 @@ class Lagrangian : public PluginObject {
   // whose M (its Hessian's vv entries at any point) would not fit an n x n buffer. The Galerkin
   // construction then takes the explicit form where its equations are explicit. ABI 12.
   virtual bool has_constant_mass_matrix() const noexcept { return false; }
-  // The Galerkin construction's explicit form run inside the plugin: `steps` Stormer-Verlet steps
-  // in place (stormer_verlet.hpp: q += d; f = dL/dq(q); d += K f, with q, d, f n numbers and K
-  // n x n, column-major), for a dense L = 1/2 v^T M v - V(q) with m = n. The plugin boundary is
-  // then crossed once for all the steps, not once a step. The numbers must be those of the same
-  // recurrence with dL/dq from evaluate() (the conformance suite checks it); non-finite numbers
-  // are left as they come (the caller checks the result). ABI 13.
-  virtual bool runs_verlet_steps() const noexcept { return false; }
-  virtual Status verlet_steps(double* /*q*/, double* /*d*/, double* /*f*/, const double* /*K*/,
-                              long /*steps*/) noexcept {
-    return "this Lagrangian does not run Stormer-Verlet steps (derive it from sdk::AutodiffLagrangian)";
-  }
-  // The shooting construction's shot run inside the plugin (explicit_shot.hpp: an explicit
-  // Runge-Kutta method, L = 1/2 v^T M v - V(q) with a constant mass matrix on R^n with m = n, no
-  // forces): the action S into `action` and the end's offsets q^n - (q0 + eta) into `offsets` (n),
-  // jets of the 2n variables x = (eta, w0), from one call instead of one a stage and a node.
-  // runs_shots(plan) says whether the plugin takes that plan (its n and number of stages); the
-  // numbers must be those of explicit_shot with dL/dq from gradient_jet (the conformance suite
-  // checks it). The Hessians need only their columns in w0, which are all that the shooting
-  // Newton's Jacobian reads (shooting.hpp); the SDK carries only those (FixedJet<2n, n>) and leaves
-  // the block in eta x eta zero. ABI 14.
-  virtual bool runs_shots(const ShotPlan& /*plan*/) const noexcept { return false; }
-  virtual Status shoot(const ShotPlan& /*plan*/, const double* /*q0*/, const double* /*w0*/, double /*h*/,
-                       Jet2* /*action*/, Jet2* /*offsets*/) noexcept {
-    return "this Lagrangian does not run shots (derive it from sdk::AutodiffLagrangian)";
+  // Kernels (kernels.hpp): whether the plugin runs the kernel of this call (its id, version and,
+  // where the kernel says so, the arguments that decide it), and running it. The defaults offer
+  // none; core then runs the same recurrence through the evaluations above. ABI 15 (replacing
+  // ABI 13's verlet_steps and ABI 14's shoot).
+  virtual bool offers(const KernelCall& /*call*/) const noexcept { return false; }
+  virtual Status run(const KernelCall& /*call*/) noexcept {
+    return "this Lagrangian runs no kernels (derive it from sdk::AutodiffLagrangian)";
   }
   // L and its gradient [dL/dq, dL/dv] at jet inputs (q, v): the jets of L(q(x), v(x)) and of its
   // gradient for the jet variables x (value may be null). The shooting construction integrates

@@ -4,8 +4,10 @@
 // SE(3), R then x); tangent vectors, velocities and momenta are dim() numbers, left-trivialized
 // on a Lie group.
 //
-// A manifold declares its structure: a vector space (is_vector_space(), the chart is affine), or
-// a Lie group whose natural chart it gives to second order (chart, local_derivatives). The
+// A manifold declares its structure (structure()): a vector space (the chart is affine), a Lie
+// group whose natural chart it gives to second order (chart, local_derivatives), a homogeneous
+// space of a Lie group (such as S2 = SO(3)/SO(2), a point moved by the group's action), or a
+// product of manifolds (a product of Lie groups is itself a Lie group, and declares lie_group). The
 // derivatives cross the boundary as plain arrays sized by the caller, so no capacity of the
 // interface limits the group's dimension. A plugin author writes the group's operations once,
 // templated on the scalar, and the SDK's adapter (varia/sdk/lie_group.hpp) derives these.
@@ -15,6 +17,21 @@
 #include "varia/core/plugin_object.hpp"
 
 namespace varia {
+
+// What a manifold is, beyond its charts: the constructions choose their equations by it (in the
+// coordinates of a vector space, with the Lagrangian's sparsity; in a Lie group's natural chart).
+// New kinds are appended; a construction refuses a structure it does not serve when it is built.
+enum class ManifoldStructure { vector_space, lie_group, homogeneous_space, product };
+
+inline const char* structure_name(ManifoldStructure structure) {
+  switch (structure) {
+    case ManifoldStructure::vector_space: return "vector space";
+    case ManifoldStructure::lie_group: return "Lie group";
+    case ManifoldStructure::homogeneous_space: return "homogeneous space";
+    case ManifoldStructure::product: return "product";
+  }
+  return "unknown";
+}
 
 // A quantity of k components and its first and second derivatives in V variables, in buffers the
 // caller sizes: value k numbers, gradient k x V, hessian k x V x V, component-major (the gradient
@@ -30,9 +47,10 @@ class Manifold : public PluginObject {
   Kind kind() const noexcept final { return Kind::manifold; }
   virtual int point_size() const noexcept = 0;
   virtual int dim() const noexcept = 0;
+  virtual ManifoldStructure structure() const noexcept = 0;  // ABI 15 (was is_vector_space())
   // True when the natural chart is affine, q = q0 + xi (a vector space): the constructions then
   // assemble their equations directly in the coordinates, with the Lagrangian's sparsity.
-  virtual bool is_vector_space() const noexcept = 0;
+  bool is_vector_space() const noexcept { return structure() == ManifoldStructure::vector_space; }
   virtual Status retract(const double* q0, const double* xi, double* q) noexcept = 0;
   virtual Status local(const double* q0, const double* q, double* xi) noexcept = 0;
   // Checks that q is a point of the manifold (to a tolerance); fills `why` when it is not.

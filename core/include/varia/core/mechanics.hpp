@@ -49,14 +49,14 @@ class LagrangianEvaluator {
   void gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient);
   // L's (m+n)^2 Hessian numbers at jet inputs, dense column-major. Counted as a Hessian evaluation.
   void hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian);
-  // `steps` Stormer-Verlet steps run inside the plugin (Lagrangian::verlet_steps, where
-  // plugin().runs_verlet_steps()), counted as that many gradients. False where a result is not
+  // `steps` Stormer-Verlet steps run inside the plugin (kernel::StormerVerletSteps, where the
+  // plugin offers it), counted as that many gradients. False where a result is not
   // finite: a non-finite gradient makes q non-finite from the next step on, and q stays so, so the
   // end shows any. q, d, f are then unspecified; the caller retakes the steps a gradient at a time,
   // which finds the step that fails.
   bool verlet_steps(double* q, double* d, double* f, const double* K, long steps);
-  // The shooting construction's shot run inside the plugin (Lagrangian::shoot, where
-  // plugin().runs_shots(plan)), counted as its evaluations at jets (shot_evaluations). Throws
+  // The shooting construction's shot run inside the plugin (kernel::ExplicitShot, where the plugin
+  // offers it for the plan), counted as its evaluations at jets (shot_evaluations). Throws
   // NumericalFailure where S or an offset is not finite.
   void shoot(const ShotPlan& plan, const double* q0, const double* w0, double h, Jet2* action, Jet2* offsets);
   const EvaluationCounters& counters() const { return counters_; }

@@ -4,7 +4,7 @@
 // the shooting construction obtains the exact first and second sensitivities of the propagation.
 #pragma once
 
-#include "varia/core/explicit_shot.hpp"
+#include "varia/core/kernels.hpp"
 #include "varia/core/jet.hpp"
 #include "varia/core/plugin_object.hpp"
 
@@ -68,7 +68,7 @@ class OneStepMethod : public PluginObject {
   virtual void set_solver(double tolerance, int max_iterations) noexcept = 0;
   // An explicit Runge-Kutta method's Butcher tableau (stages = 0 for any other method): its step
   // is then explicit_runge_kutta_step with it, and the shooting construction may run its shots
-  // inside the Lagrangian's plugin (explicit_shot.hpp). The pointers stay valid while the
+  // inside the Lagrangian's plugin (kernel::ExplicitShot). The pointers stay valid while the
   // method lives. ABI 14.
   virtual RungeKuttaTableau explicit_tableau() const noexcept { return {}; }
   // y1 = Psi_h(y0) for y in R^N, N = field.size(). At jets, y1 carries the exact derivatives of

@@ -21,7 +21,11 @@ namespace varia {
 // 11: Effect::gradient_jet, Effect::evaluates_at_jets; 12: Lagrangian::has_constant_mass_matrix;
 // 13: Lagrangian::runs_verlet_steps, Lagrangian::verlet_steps, Lagrangian::gradients.
 // 14: Lagrangian::runs_shots, Lagrangian::shoot, OneStepMethod::explicit_tableau.
-inline constexpr int kAbiVersion = 14;
+// 15: Lagrangian::offers and Lagrangian::run, one entry point for every kernel (kernels.hpp),
+// replacing runs_verlet_steps, verlet_steps, runs_shots and shoot; Manifold::structure(),
+// replacing is_vector_space(). A kernel added or changed later
+// is a new id or version of kernels.hpp, not a new ABI version.
+inline constexpr int kAbiVersion = 15;
 
 using Status = const char*;
 

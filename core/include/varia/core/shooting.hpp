@@ -62,7 +62,7 @@
 //
 // Where the shot is one fixed recurrence (an explicit Runge-Kutta method, the lagrangian form on
 // R^n, a constant mass matrix, no forces, no end corrections: explicit_shot.hpp), the Lagrangian's
-// plugin runs it whole with its model inlined (Lagrangian::shoot), where it takes the plan (the
+// plugin runs it whole with its model inlined (kernel::ExplicitShot), where it takes the plan (the
 // SDK's models: n <= 3); the same numbers as the propagation through the method's plugin.
 //
 // Restrictions: a Lie group of dimension n <= 6 (one pass of jets of 2n <= 12 variables: SE(3));

@@ -5,7 +5,7 @@
 //   q += d;  f = dL/dq(q);  d += K f,   K = h^2 (b0 + b1) M^{-1},
 // `steps` times in place (galerkin.cpp derives it). One piece of code for both places that run it:
 // the core, whose `force` is a plugin call a step (GalerkinDiscreteLagrangian::explicit_advance),
-// and the SDK inside the plugin, with the model's dL/dq inlined (Lagrangian::verlet_steps), so that
+// and the SDK inside the plugin, with the model's dL/dq inlined (kernel::StormerVerletSteps), so that
 // both take the same steps to the bit.
 #pragma once
 

@@ -1,13 +1,16 @@
 // A Lagrangian written once, templated on its scalar, with exact derivatives by forward-mode
 // automatic differentiation (dual.hpp: Eigen's AutoDiffScalar; nested once for the Hessian). The
-// model class derives from AutodiffLagrangian<Model> and defines
+// model class derives from AutodiffLagrangian<Model> (sizes read at run time: m and n given to the
+// constructor) or AutodiffLagrangian<Model, M, N> (sizes known when it is compiled, as Ceres'
+// AutoDiffCostFunction takes them) and defines
 //
 //   template <class T> T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const;
 //
-// Any number m + n of positions and velocities. Up to kStackVariables (18) the derivatives are
-// taken in one pass by dual numbers on the stack, so an evaluation allocates nothing; for the common
-// sizes m + n = 2, 4, 6, 12 (Rn of dim 1, 2, 3; SO3) they have a fixed size, so the arithmetic
-// is unrolled and a second-order scalar holds (k+1)^2 doubles instead of 19^2. Above it the
+// The model is compiled once per scalar type that its sizes need, and no more: with sizes given
+// at compile time (M + N <= kMaxFixedVariables) the dual numbers have that fixed size, so the
+// arithmetic is unrolled and a second-order scalar holds (k+1)^2 doubles; with sizes read at run
+// time one family of capacity-bounded dual numbers serves every size up to kStackVariables (18),
+// on the stack, so an evaluation allocates nothing. Above it the
 // Hessian is dense all the same, and forward mode runs in chunks of kChunkDirections directions
 // over workspace vectors sized once: k/8 passes of the model for the gradient, one pass per pair
 // of chunks for the Hessian, so a Hessian costs about k^2/64 evaluations of the model at 81-double
@@ -20,29 +23,50 @@
 // form needs for a configuration-dependent mass matrix (it propagates in passes of at most that
 // many variables: any dimension up to kStackVariables / 2). The same first-order pass, inlined into
 // one loop, gives the gradients at several points in one call (gradients) and runs the Galerkin
-// explicit form's Stormer-Verlet steps inside the plugin (verlet_steps, stormer_verlet.hpp).
+// explicit form's Stormer-Verlet steps inside the plugin (kernel::StormerVerletSteps).
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <optional>
+#include <vector>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
 
+#include "varia/core/explicit_shot.hpp"
 #include "varia/core/lagrangian.hpp"
 #include "varia/core/stormer_verlet.hpp"
 #include "varia/sdk/dual.hpp"
 #include "varia/sdk/jet_tangent.hpp"
 #include "varia/sdk/plugin.hpp"
+#include "varia/sdk/velocity_structure.hpp"
 
 namespace varia::sdk {
 
-template <class Model>
+// The most numbers m + n that a model with sizes given at compile time is differentiated at in
+// fixed-size dual numbers (SO(3): 9 + 3); above it the capacity-bounded ones serve it too.
+inline constexpr int kMaxFixedVariables = 12;
+
+template <class Model, int Positions = Eigen::Dynamic, int Velocities = Positions>
 class AutodiffLagrangian : public Lagrangian {
+  // Sizes known at compile time (and small enough for fixed-size duals): the one shape compiled.
+  static constexpr bool kFixed = Positions != Eigen::Dynamic && Velocities != Eigen::Dynamic && Positions + Velocities <= kMaxFixedVariables;
+  static constexpr int kShapeM = kFixed ? Positions : Eigen::Dynamic;
+  using FirstDual = std::conditional_t<kFixed, FixedDual<kFixed ? Positions + Velocities : 1>, Dual>;
+  using SecondDual = std::conditional_t<kFixed, FixedDual2<kFixed ? Positions + Velocities : 1>, Dual2>;
+  // Jets of 2n variables (a shooting step's (eta, w0) on R^n) at a fixed size, for n <= 3.
+  static constexpr int kFixedJetVariables = kFixed && Positions == Velocities && 2 * Velocities <= kMaxHessianJetVariables ? 2 * Velocities : 0;
+
  public:
+  AutodiffLagrangian()
+    requires(Positions != Eigen::Dynamic && Velocities != Eigen::Dynamic)
+      : AutodiffLagrangian(Positions, Velocities) {}
   AutodiffLagrangian(int position_size, int velocity_size)
       : m_(position_size), n_(velocity_size), q_(position_size), v_(velocity_size) {
+    if ((Positions != Eigen::Dynamic && m_ != Positions) || (Velocities != Eigen::Dynamic && n_ != Velocities))
+      throw std::logic_error("an AutodiffLagrangian<Model, Positions, Velocities> is constructed with m = Positions and n = Velocities");
     if (m_ + n_ > kStackVariables) {
       chunk_q_.resize(m_), chunk_v_.resize(n_);
       chunk2_q_.resize(m_), chunk2_v_.resize(n_);
@@ -59,21 +83,17 @@ class AutodiffLagrangian : public Lagrangian {
         q_ = Eigen::Map<const Vec<double>>(q, m_);
         v_ = Eigen::Map<const Vec<double>>(v, n_);
         *value = model().lagrangian(q_, v_);
-      } else if (m_ + n_ > kStackVariables) {
-        if (hessian != nullptr) chunked_second_order(q, v, value, gradient, hessian);
-        else chunked_first_order(q, v, value, gradient);
+      } else if (above_stack()) {
+        if constexpr (!kFixed) {
+          if (hessian != nullptr) chunked_second_order(q, v, value, gradient, hessian);
+          else chunked_first_order(q, v, value, gradient);
+        }
       } else if (hessian != nullptr)
-        dispatch([&](auto, auto second, auto) {
-          second_order<typename decltype(second)::type>(q, v, value, gradient, hessian);
-        });
-      else if (gradient != nullptr && value != nullptr)
-        dispatch([&](auto first, auto, auto m) {
-          first_order<typename decltype(first)::type, decltype(m)::value, true>(q, v, value, gradient);
-        });
-      else if (gradient != nullptr)
-        dispatch([&](auto first, auto, auto m) {
-          first_order<typename decltype(first)::type, decltype(m)::value, false>(q, v, value, gradient);
-        });
+        second_order<SecondDual>(q, v, value, gradient, hessian);
+      else if (value != nullptr)
+        first_order<FirstDual, kShapeM, true>(q, v, value, gradient);
+      else
+        first_order<FirstDual, kShapeM, false>(q, v, value, gradient);
     });
   }
 
@@ -81,47 +101,59 @@ class AutodiffLagrangian : public Lagrangian {
   Status gradients(int count, const double* points, double* gradients) noexcept final {
     return guarded(error_, [&] {
       const int k = m_ + n_;
-      if (k > kStackVariables) {
-        for (int i = 0; i < count; ++i) chunked_first_order(points + i * k, points + i * k + m_, nullptr, gradients + i * k);
-        return;
-      }
-      dispatch([&](auto first, auto, auto m) {
-        gradients_loop<typename decltype(first)::type, decltype(m)::value>(count, points, gradients);
-      });
+      if constexpr (!kFixed)
+        if (above_stack()) {
+          for (int i = 0; i < count; ++i)
+            chunked_first_order(points + i * k, points + i * k + m_, nullptr, gradients + i * k);
+          return;
+        }
+      gradients_loop<FirstDual, kShapeM>(count, points, gradients);
     });
   }
 
-  // The explicit form's Stormer-Verlet steps with the model inlined in the loop: for m = n and
-  // m + n <= kStackVariables (the dual numbers of first_order).
-  bool runs_verlet_steps() const noexcept final { return m_ == n_ && m_ + n_ <= kStackVariables; }
-  Status verlet_steps(double* q, double* d, double* f, const double* K, long steps) noexcept final {
+  // The kernels (core/kernels.hpp) with the model inlined: Galerkin's explicit form's
+  // Stormer-Verlet steps, for m = n and m + n <= kStackVariables (the dual numbers of
+  // first_order); the shooting construction's shot, for sizes given at compile time, m = n up to
+  // kMaxShotDimension, and explicit methods of up to kMaxShotStages stages (other models take the
+  // core's run of the same recurrences).
+  bool offers(const KernelCall& call) const noexcept final {
+    if (kernel::arguments<kernel::StormerVerletSteps>(call) != nullptr) return runs_verlet_steps();
+    if (const auto* shot = kernel::arguments<kernel::ExplicitShot>(call); shot != nullptr && shot->plan != nullptr)
+      return runs_shot(*shot->plan);
+    return false;
+  }
+  Status run(const KernelCall& call) noexcept final {
     return guarded(error_, [&] {
-      if (!runs_verlet_steps())
-        throw std::length_error("an autodiff Lagrangian runs Stormer-Verlet steps for m = n and at most " +
-                                std::to_string(kStackVariables) + " position and velocity numbers together");
-      dispatch([&](auto first, auto, auto m) {
-        verlet_loop<typename decltype(first)::type, decltype(m)::value>(q, d, f, K, steps);
-      });
+      if (!offers(call)) throw std::invalid_argument("a kernel call that this Lagrangian does not offer");
+      if (const auto* verlet = kernel::arguments<kernel::StormerVerletSteps>(call)) {
+        if constexpr (!kFixed || Positions == Velocities)
+          verlet_loop<FirstDual, kShapeM>(verlet->q, verlet->d, verlet->f, verlet->K, verlet->steps);
+      } else if (const auto* shot = kernel::arguments<kernel::ExplicitShot>(call)) {
+        if constexpr (kFixed && Positions == Velocities && Velocities <= kMaxShotDimension)
+          fixed_shot<Velocities>(*shot->plan, shot->q0, shot->w0, shot->h, shot->action, shot->offsets);
+      }
     });
   }
 
-  // The shooting construction's shot with the model inlined (explicit_shot.hpp): for m = n up to
-  // kMaxShotDimension and explicit methods of up to kMaxShotStages stages.
-  bool runs_shots(const ShotPlan& plan) const noexcept final {
-    return m_ == n_ && plan.n == n_ && n_ <= kMaxShotDimension && plan.method.stages <= kMaxShotStages;
-  }
-  Status shoot(const ShotPlan& plan, const double* q0, const double* w0, double h, Jet2* action,
-               Jet2* offsets) noexcept final {
-    return guarded(error_, [&] {
-      if (!runs_shots(plan))
-        throw std::length_error("an autodiff Lagrangian runs shots for m = n <= " + std::to_string(kMaxShotDimension) +
-                                " and explicit methods of at most " + std::to_string(kMaxShotStages) + " stages");
-      switch (n_) {
-        case 1: return fixed_shot<1>(plan, q0, w0, h, action, offsets);
-        case 2: return fixed_shot<2>(plan, q0, w0, h, action, offsets);
-        default: return fixed_shot<3>(plan, q0, w0, h, action, offsets);
+  // L = 1/2 v^T M v - V(q) with a constant M, read off the model's expression
+  // (velocity_structure.hpp), so that no model need declare it: M is then L's Hessian's vv block,
+  // the same at every point (here (q, v) = (1/2, ..., 0)). A model may still override this (as
+  // its own declaration, or to refuse the explicit forms); the conformance suite checks a declared
+  // M against the Hessian.
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    if (!has_constant_mass_form()) return false;
+    const int k = m_ + n_;
+    std::vector<double> q(m_, 0.5), v(n_, 0.0), hessian(k * k);
+    // evaluate() keeps no state between calls but the workspace it overwrites.
+    if (const_cast<AutodiffLagrangian*>(this)->evaluate(q.data(), v.data(), nullptr, nullptr, hessian.data()) != nullptr)
+      return false;
+    for (int j = 0; j < n_; ++j)
+      for (int i = 0; i < n_; ++i) {
+        const double entry = hessian[(m_ + j) * k + m_ + i];
+        if (!std::isfinite(entry)) return false;
+        mass[j * n_ + i] = entry;
       }
-    });
+    return true;
   }
 
   // At jets the model runs at dual numbers on the stack: up to kStackVariables numbers (q, v). Above
@@ -132,12 +164,9 @@ class AutodiffLagrangian : public Lagrangian {
       if (m_ + n_ > kStackVariables)
         throw std::length_error("an autodiff Lagrangian evaluates at jets with at most " +
                                  std::to_string(kStackVariables) + " position and velocity numbers together");
-      switch (jet_variables(q, v)) {
-        case 2: return at_fixed_jets<2>(q, v, value, gradient);
-        case 4: return at_fixed_jets<4>(q, v, value, gradient);
-        case 6: return at_fixed_jets<6>(q, v, value, gradient);
-        default: return at_jets(q, v, value, gradient);
-      }
+      if constexpr (kFixedJetVariables > 0)
+        if (jet_variables(q, v) == kFixedJetVariables) return at_fixed_jets<kFixedJetVariables>(q, v, value, gradient);
+      at_jets(q, v, value, gradient);
     });
   }
   int hessian_jet_variables() const noexcept final { return m_ + n_ <= kStackVariables ? kMaxHessianJetVariables : 0; }
@@ -148,9 +177,10 @@ class AutodiffLagrangian : public Lagrangian {
                                 std::to_string(kStackVariables) + " position and velocity numbers together");
       const int variables = jet_variables(q, v);
       if (variables == 0) return hessian_at_constants(q, v, hessian);
-      if (variables <= 2) return hessian_at_fixed_jets<2>(q, v, variables, hessian);
-      if (variables <= 4) return hessian_at_fixed_jets<4>(q, v, variables, hessian);
-      if (variables <= kMaxHessianJetVariables) return hessian_at_fixed_jets<6>(q, v, variables, hessian);
+      if constexpr (kFixedJetVariables > 0 && kFixedJetVariables < kMaxHessianJetVariables)
+        if (variables <= kFixedJetVariables) return hessian_at_fixed_jets<kFixedJetVariables>(q, v, variables, hessian);
+      if (variables <= kMaxHessianJetVariables)
+        return hessian_at_fixed_jets<kMaxHessianJetVariables>(q, v, variables, hessian);
       throw std::length_error("an autodiff Lagrangian gives its Hessian at jets of at most " +
                               std::to_string(kMaxHessianJetVariables) + " variables (hessian_jet_variables())");
     });
@@ -161,36 +191,25 @@ class AutodiffLagrangian : public Lagrangian {
 
  private:
   const Model& model() const { return static_cast<const Model&>(*this); }
+  bool runs_verlet_steps() const { return m_ == n_ && m_ + n_ <= kStackVariables; }
+  bool runs_shot(const ShotPlan& plan) const {
+    return kFixed && Positions == Velocities && Velocities <= kMaxShotDimension && plan.n == n_ &&
+           plan.method.stages <= kMaxShotStages;
+  }
+  // Whether the model's L is 1/2 v^T M v - V(q) with M constant, read once from its expression.
+  bool has_constant_mass_form() const {
+    if (!constant_mass_form_)
+      constant_mass_form_ = sdk::has_constant_mass_form(
+          m_, n_, [&](const Vec<VelocityStructure>& q, const Vec<VelocityStructure>& v) { return model().lagrangian(q, v); });
+    return *constant_mass_form_;
+  }
+  // Whether (q, v) has more numbers than dual numbers on the stack take (the chunked passes).
+  bool above_stack() const { return !kFixed && m_ + n_ > kStackVariables; }
   // Number k of (q, v), q having m numbers.
   template <class T>
   static const T& at(const T* q, const T* v, int m, int k) { return k < m ? q[k] : v[k - m]; }
   template <class T>
   T& input(Vec<T>& q, Vec<T>& v, int k) const { return k < m_ ? q(k) : v(k - m_); }
-
-  // Calls f with tags (std::type_identity) of the first- and second-order scalar types for
-  // k = m + n, and m as a compile-time constant (Shape): fixed-size types where k is one of the
-  // common sizes, with m fixed too for the common shapes (R^1..R^3: m = n; SO(3): 9 + 3), so that
-  // every index of the first-order seeding is known at compile time; else the capacity-bounded
-  // dynamic types and m = Eigen::Dynamic (read at run time).
-  template <class T>
-  using Tag = std::type_identity<T>;
-  template <int M>
-  using Shape = std::integral_constant<int, M>;
-  template <class F>
-  void dispatch(F&& f) const {
-    switch (m_ + n_) {
-      case 2: return common_shape<2, 1>(f);
-      case 4: return common_shape<4, 2>(f);
-      case 6: return common_shape<6, 3>(f);
-      case 12: return common_shape<12, 9>(f);
-      default: return f(Tag<Dual>(), Tag<Dual2>(), Shape<Eigen::Dynamic>());
-    }
-  }
-  template <int K, int M, class F>
-  void common_shape(F& f) const {
-    if (m_ == M) return f(Tag<FixedDual<K>>(), Tag<FixedDual2<K>>(), Shape<M>());
-    return f(Tag<FixedDual<K>>(), Tag<FixedDual2<K>>(), Shape<Eigen::Dynamic>());
-  }
 
   // L and its gradient by forward mode: one derivative direction per number of (q, v). For a
   // fixed-size D the loop runs to the compile-time size, so that it unrolls and each seed e_i is
@@ -203,9 +222,7 @@ class AutodiffLagrangian : public Lagrangian {
   // varia builds with -fno-math-errno (the evaluator checks finiteness instead), so that a model
   // written c * cos(q) with a double c costs sin q alone (written T(c) * cos(q), the derivative
   // multiplies c's zero derivatives by cos q, and IEEE arithmetic keeps that: sincos).
-  // The model is compiled for every common shape, also those it never runs with (an SO(3) model
-  // at m = 1, whose q(6) would read past the size): GCC's warnings of uninitialized reads there
-  // are about code that never runs.
+  // GCC warns of uninitialized reads in the fixed-size seeding that it cannot follow.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
@@ -238,7 +255,7 @@ class AutodiffLagrangian : public Lagrangian {
       first_order_inline<D, M, false>(points + i * k, points + i * k + m_, nullptr, gradients + i * k);
   }
 
-  // verlet_steps with n = M (or m_, for M = Dynamic): the recurrence of stormer_verlet.hpp with
+  // The Stormer-Verlet kernel with n = M (or m_, for M = Dynamic): the recurrence of stormer_verlet.hpp with
   // the model's dL/dq inlined (flatten), read at (q, v = 0) from one small local array, as the
   // core does a step at a time. For a fixed n the state stays in fixed-size vectors.
   template <class D, int M>
@@ -280,7 +297,7 @@ class AutodiffLagrangian : public Lagrangian {
   template <int N>
   [[gnu::noinline, gnu::flatten]] void fixed_shot(const ShotPlan& plan, const double* q0, const double* w0, double h,
                                                   Jet2* action, Jet2* offsets) const {
-    using J = FixedJet<2 * N, N>;  // the Hessians' columns in w0 only (Lagrangian::shoot)
+    using J = FixedJet<2 * N, N>;  // the Hessians' columns in w0 only (kernel::ExplicitShot)
     using D = JetDual<N, J>;
     std::array<J, 10 * N + 2 * N * kMaxShotStages> work;
     std::array<J, N> end;
@@ -331,9 +348,13 @@ class AutodiffLagrangian : public Lagrangian {
   // per block of kJetDirections.
   template <class J>
   void at_jets(const J* q, const J* v, J* value, J* gradient) const {
-    if (m_ + n_ <= 2) return jet_first_order<2>(q, v, 0, value, gradient);
-    for (int first = 0; first < m_ + n_; first += kJetDirections)
-      jet_first_order<kJetDirections>(q, v, first, first == 0 ? value : nullptr, gradient);
+    if constexpr (kFixed && Positions + Velocities <= 2) {
+      jet_first_order<2>(q, v, 0, value, gradient);
+    } else {
+      if (!kFixed && m_ + n_ <= 2) return jet_first_order<2>(q, v, 0, value, gradient);
+      for (int first = 0; first < m_ + n_; first += kJetDirections)
+        jet_first_order<kJetDirections>(q, v, first, first == 0 ? value : nullptr, gradient);
+    }
   }
   // L (if value is not null) and the derivatives in the numbers first .. first + K - 1 of (q, v)
   // (those that exist) at jet inputs: forward mode over the jets, one derivative direction per
@@ -398,9 +419,7 @@ class AutodiffLagrangian : public Lagrangian {
     const int k = m_ + n_;
     for (int i = 0; i < k; ++i) input(q_, v_, i) = at(q, v, m_, i).value;
     std::array<double, kStackVariables * kStackVariables> values;
-    dispatch([&](auto, auto second, auto) {
-      second_order<typename decltype(second)::type>(q_.data(), v_.data(), nullptr, nullptr, values.data());
-    });
+    second_order<SecondDual>(q_.data(), v_.data(), nullptr, nullptr, values.data());
     for (int i = 0; i < k * k; ++i) hessian[i] = Jet2(values[i]);
   }
 
@@ -453,6 +472,7 @@ class AutodiffLagrangian : public Lagrangian {
   }
 
   int m_, n_;
+  mutable std::optional<bool> constant_mass_form_;
   // Workspace, sized once: the value's inputs, and above kStackVariables the chunks' dual inputs.
   Vec<double> q_, v_;
   Vec<ChunkDual> chunk_q_, chunk_v_;

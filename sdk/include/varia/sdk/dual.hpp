@@ -32,7 +32,7 @@ inline constexpr int kJetDirections = 4;
 // variables (FixedJet: a second-order scalar over FixedJet<6> holds 9 x 43 doubles).
 inline constexpr int kHessianJetDirections = 2;
 inline constexpr int kMaxHessianJetVariables = 6;
-// The shooting construction's shot runs inside the plugin (Lagrangian::shoot) with fixed-size jets
+// The shooting construction's shot runs inside the plugin (kernel::ExplicitShot) with fixed-size jets
 // of 2n variables for n <= kMaxShotDimension, and explicit methods of at most kMaxShotStages stages
 // (its workspace on the stack); other plans take the core's generic propagation.
 inline constexpr int kMaxShotDimension = 3;

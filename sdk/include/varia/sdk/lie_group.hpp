@@ -163,7 +163,7 @@ class LieGroupManifold : public Manifold {
 
   int point_size() const noexcept final { return m; }
   int dim() const noexcept final { return n; }
-  bool is_vector_space() const noexcept final { return false; }
+  ManifoldStructure structure() const noexcept final { return ManifoldStructure::lie_group; }
 
   Status retract(const double* q0, const double* xi, double* q) noexcept override {
     return guarded(error_, [&] {

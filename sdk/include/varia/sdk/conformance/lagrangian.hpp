@@ -143,13 +143,14 @@ inline void check_jets(Lagrangian& lagrangian, unsigned seed, const VectorXd& q,
         [&](double eps) { return at_doubles(eps).hessian.reshaped().eval(); }, "the Hessian", failures);
 }
 
-// Where the plugin runs the explicit form's Stormer-Verlet steps itself (runs_verlet_steps), five
+// Where the plugin runs the explicit form's Stormer-Verlet steps itself (kernel::StormerVerletSteps), five
 // of them from (q, d = h v, f = dL/dq(q)) with K = h^2 M^{-1} (h = 0.1; K = h^2 I without a
 // constant mass matrix: the recurrence is defined all the same) give the numbers of the same
 // recurrence with dL/dq from evaluate(), at v = 0, to round-off.
 inline void check_verlet_steps(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v, Failures& failures) {
   const int n = lagrangian.velocity_size();
-  if (!lagrangian.runs_verlet_steps() || lagrangian.position_size() != n) return;
+  kernel::StormerVerletSteps verlet;
+  if (!lagrangian.offers(kernel::call(verlet)) || lagrangian.position_size() != n) return;
   const double h = 0.1;
   const long steps = 5;
   const VectorXd zero = VectorXd::Zero(n);
@@ -160,13 +161,13 @@ inline void check_verlet_steps(Lagrangian& lagrangian, const VectorXd& q, const 
   VectorXd own_q = plugin_q, own_d = plugin_d, own_f = plugin_f;
   stormer_verlet_steps(own_q, own_d, own_f, K, steps,
                        [&](const VectorXd& x, VectorXd& f) { f = gradient(lagrangian, x, zero).head(n); });
-  check(lagrangian, lagrangian.verlet_steps(plugin_q.data(), plugin_d.data(), plugin_f.data(), K.data(), steps),
-        "verlet_steps");
+  verlet = {plugin_q.data(), plugin_d.data(), plugin_f.data(), K.data(), steps};
+  check(lagrangian, lagrangian.run(kernel::call(verlet)), "the Stormer-Verlet steps kernel");
   const double scale = std::max({1.0, own_q.cwiseAbs().maxCoeff(), own_d.cwiseAbs().maxCoeff() / h,
                                  own_f.cwiseAbs().maxCoeff()});
   const double error = std::max({(plugin_q - own_q).cwiseAbs().maxCoeff(), (plugin_d - own_d).cwiseAbs().maxCoeff() / h,
                                  (plugin_f - own_f).cwiseAbs().maxCoeff()});
-  failures.expect(error <= 1e-13 * scale, "verlet_steps gives (q, d, f) ", error,
+  failures.expect(error <= 1e-13 * scale, "the Stormer-Verlet steps kernel gives (q, d, f) ", error,
                   " away from the Stormer-Verlet recurrence with dL/dq from evaluate() (5 steps of h = 0.1)");
 }
 
@@ -184,10 +185,10 @@ inline double jet_gap(const Jet2& jet, const Jet2& reference, int columns) {
   return error / scale;
 }
 
-// Where the plugin runs the shooting construction's shots itself (runs_shots) and declares a
+// Where the plugin runs the shooting construction's shots itself (kernel::ExplicitShot) and declares a
 // constant mass matrix: a shot of rk4 through Simpson's nodes (the paper's SVIRK4) from (q, w0 = v)
 // at h = 0.1 gives S and the end's offsets, values, first derivatives in (eta, w0) and second
-// derivatives in the columns of w0 (those the shooting Newton reads, Lagrangian::shoot), of the
+// derivatives in the columns of w0 (those the shooting Newton reads, kernel::ExplicitShot), of the
 // recurrence (explicit_shot.hpp) with L and dL/dq from gradient_jet, to round-off.
 inline void check_shot(Lagrangian& lagrangian, const VectorXd& q, const VectorXd& v, Failures& failures) {
   const int n = lagrangian.velocity_size();
@@ -200,11 +201,14 @@ inline void check_shot(Lagrangian& lagrangian, const VectorXd& q, const VectorXd
   static constexpr double nodes[3] = {0, 0.5, 1}, weights[3] = {1.0 / 6, 4.0 / 6, 1.0 / 6};
   const ShotPlan plan{{rk4.stages(), rk4.a.data(), rk4.b.data(), rk4.c.data()}, 3, nodes, weights, n,
                       inverse_mass.data()};
-  if (!lagrangian.runs_shots(plan)) return;
+  kernel::ExplicitShot shot;
+  shot.plan = &plan;
+  if (!lagrangian.offers(kernel::call(shot))) return;
   const double h = 0.1;
   std::vector<Jet2> offsets(n), reference_offsets(n), work(shot_workspace(plan)), gradient(2 * n);
   Jet2 action, reference_action;
-  check(lagrangian, lagrangian.shoot(plan, q.data(), v.data(), h, &action, offsets.data()), "shoot");
+  shot = {&plan, q.data(), v.data(), h, &action, offsets.data()};
+  check(lagrangian, lagrangian.run(kernel::call(shot)), "the explicit shot kernel");
   explicit_shot(plan, q.data(), v.data(), h, reference_action, reference_offsets.data(), work.data(),
                 [&](const Jet2* x, const Jet2* w, Jet2* L, Jet2* Lq) {
                   check(lagrangian, lagrangian.gradient_jet(x, w, L, gradient.data()), "Lagrangian gradient at jets");
@@ -212,7 +216,7 @@ inline void check_shot(Lagrangian& lagrangian, const VectorXd& q, const VectorXd
                 });
   double error = jet_gap(action, reference_action, n);
   for (int r = 0; r < n; ++r) error = std::max(error, jet_gap(offsets[r], reference_offsets[r], n));
-  failures.expect(error <= 1e-13, "shoot gives S and the offsets ", error,
+  failures.expect(error <= 1e-13, "the explicit shot kernel gives S and the offsets ", error,
                   " (relative) away from the recurrence of explicit_shot.hpp with gradient_jet (rk4, Simpson, h = 0.1)");
 }
 
