@@ -26,18 +26,11 @@ namespace varia::host {
 namespace {
 
 // One line, whatever the message holds: control characters (newlines, terminal escapes, NUL)
-// shown as \xNN, and text quoted from the input cut to a bounded length. Never throws: a closed
-// or full stderr loses the message, not the exit code.
+// shown as \xNN (printable), and text quoted from the input cut to a bounded length. Never throws:
+// a closed or full stderr loses the message, not the exit code.
 void report(const std::string& message) {
   constexpr std::size_t kMaxShown = 2000;
-  std::string line = "varia: error: ";
-  for (std::size_t i = 0; i < message.size() && i < kMaxShown; ++i) {
-    const auto c = static_cast<unsigned char>(message[i]);
-    if (c < 0x20 || c == 0x7f)
-      line += fmt::format("\\x{:02x}", c);
-    else
-      line += static_cast<char>(c);
-  }
+  std::string line = "varia: error: " + printable(std::string_view(message).substr(0, kMaxShown));
   if (message.size() > kMaxShown) line += fmt::format("... ({} more bytes)", message.size() - kMaxShown);
   line += '\n';
   (void)std::fwrite(line.data(), 1, line.size(), stderr);

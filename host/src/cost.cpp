@@ -189,10 +189,11 @@ std::vector<double> step_sizes(const Scene& scene, const CostOptions& options) {
   return h;
 }
 
-// A progress line on stderr when it is a terminal (spec: "Progress and diagnostics").
+// A progress line on stderr when it is a terminal (spec: "Progress and diagnostics"); the scene's
+// name in it is shown printable.
 void progress(const CostOptions& options, const std::string& text) {
   if (options.quiet || !::isatty(STDERR_FILENO)) return;
-  std::fprintf(stderr, "\r\033[K%s", text.c_str());
+  std::fprintf(stderr, "\r\033[K%s", printable(text).c_str());
   std::fflush(stderr);
 }
 
@@ -207,7 +208,8 @@ void sweep(Method& m, const CostOptions& options, int index, int count) {
       m.rows.push_back(measure(m, t_end / steps, steps));
     } catch (const NumericalFailure& e) {
       progress(options, "");
-      fmt::print(stderr, "varia: cost: {}: h = {:.4g} skipped: {}\n", m.name, t_end / steps, e.what());
+      fmt::print(stderr, "varia: cost: {}: h = {:.4g} skipped: {}\n", printable(m.name), t_end / steps,
+                 printable(e.what()));
     }
   }
   if (m.rows.empty()) throw NumericalFailure(fmt::format("{}: no step size ran to the end", m.file), std::nan(""));
@@ -307,10 +309,12 @@ void write_plot(const std::filesystem::path& file, const std::deque<Method>& met
   write_svg(file, {work, order});
 }
 
+// The method's rows; its name, file and reference (text from the scenes) shown printable.
 void print_table(const Method& m) {
-  fmt::print(results(), "{} ({}): predicted order {}, fitted slope {}\n  error measured against the {}\n", m.name, m.file,
-             m.predicted_order, m.fit.fitted() ? fmt::format("{:.2f} ({} points)", m.fit.slope, m.fit.used) : "-",
-             m.truth->source);
+  fmt::print(results(), "{} ({}): predicted order {}, fitted slope {}\n  error measured against the {}\n",
+             printable(m.name), printable(m.file), m.predicted_order,
+             m.fit.fitted() ? fmt::format("{:.2f} ({} points)", m.fit.slope, m.fit.used) : "-",
+             printable(m.truth->source));
   fmt::print(results(), "  {:>10} {:>8} {:>11} {:>11} {:>10} {:>11} {:>11}\n", "h", "steps", "error", "energy err", "seconds",
              "Newton/step", "evals/step");
   for (const Row& r : m.rows)
@@ -369,7 +373,8 @@ int command_cost(const CommonOptions& common, const std::vector<std::string>& sc
   write_csv(options.out / "cost.csv", methods);
   write_json_file(options.out / "cost.json", record, "--out");
   write_plot(options.out / "cost.svg", methods);
-  if (!options.quiet) fmt::print(results(), "wrote {}, cost.svg, cost.json\n", (options.out / "cost.csv").string());
+  if (!options.quiet)
+    fmt::print(results(), "wrote {}, cost.svg, cost.json\n", printable((options.out / "cost.csv").string()));
   return 0;
 }
 

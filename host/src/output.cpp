@@ -235,6 +235,18 @@ void write_output(const fs::path& file, std::string_view text, std::string_view 
   replace_file(fs::exists(status) ? fs::canonical(file, ec) : file, text, what);
 }
 
+std::string printable(std::string_view text) {
+  std::string shown;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7f)
+      shown += fmt::format("\\x{:02x}", byte);
+    else
+      shown += c;
+  }
+  return shown;
+}
+
 void write_json_file(const fs::path& file, const nlohmann::ordered_json& document, std::string_view what) {
   write_output(file, document.dump(2) + "\n", what);
 }

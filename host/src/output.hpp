@@ -61,6 +61,11 @@ inline std::vector<double> as_vector(const Eigen::VectorXd& x) { return {x.data(
 // (e.g. "--summary"). Throws OutputError.
 void write_output(const std::filesystem::path& file, std::string_view text, std::string_view what);
 
+// `text` as a terminal or a one-line message may show it: control characters (newlines, terminal
+// escapes, NUL) written as \xNN, so that text from a scene or a file name can neither move the
+// cursor, nor end a line, nor cut a message short.
+std::string printable(std::string_view text);
+
 // Writes a JSON document (pretty-printed) through write_output.
 void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_json& document,
                      std::string_view what = "output");

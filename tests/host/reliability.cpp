@@ -361,6 +361,18 @@ TEST_CASE("the scene reader refuses repeated keys, NUL bytes and subnormal numbe
   write_file(dir / "s.json", scene.dump());
   CHECK(run_varia("validate " + quoted(dir / "s.json")).code == 0);
 }
+TEST_CASE("a NUL in a plugin type name is shown as \\x00, and the message goes on to list the valid types") {
+  TempDir dir;
+  json scene = oscillator_scene();
+  scene["system"]["lagrangian"]["type"] = std::string("harmonic\0oscillator", 19);
+  write_file(dir / "s.json", scene.dump());
+  const auto outcome = run_varia("validate " + quoted(dir / "s.json"));
+  CHECK(outcome.code == 2);
+  check_one_error_line(outcome, "/system/lagrangian/type: unknown lagrangian type 'harmonic\\x00oscillator'; "
+                                "valid lagrangian types are: ");
+  CHECK(contains(outcome.err, "harmonic-oscillator, "));
+}
+
 
 TEST_CASE("messages show control characters escaped and long input cut") {
   TempDir dir;
