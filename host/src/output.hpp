@@ -57,7 +57,8 @@ class CsvWriter {
 inline std::vector<double> as_vector(const Eigen::VectorXd& x) { return {x.data(), x.data() + x.size()}; }
 
 // Writes `text` to `file` ("-": stdout): a regular file (or a new one) through a temporary file
-// renamed over it, anything else (a device, a pipe) directly. `what` names the output in messages
+// renamed over it, anything else (a device, a pipe) directly. A symbolic link keeps pointing where
+// it did, also when what it names is not there yet: the file it names is written. `what` names the output in messages
 // (e.g. "--summary"). Throws OutputError.
 void write_output(const std::filesystem::path& file, std::string_view text, std::string_view what);
 

@@ -261,6 +261,25 @@ TEST_CASE("the run record replaces the file by a rename: a second name of the ol
   CHECK(json::parse(read_file(dir / "r.json")).contains("steps"));
   CHECK(files_in(dir.path(), ".json").size() == 1);  // no temporary file left
 }
+TEST_CASE("the run record is written under a 255-byte file name, and through a link to a file not there yet") {
+  TempDir dir;
+  const fs::path longest = dir / (std::string(250, 'r') + ".json");
+  auto outcome = run_varia("run scenes/default.json --quiet --summary " + quoted(longest));
+  CAPTURE(outcome.err);
+  CHECK(outcome.code == 0);
+  CHECK(json::parse(read_file(longest)).contains("steps"));
+  CHECK(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()) == 1);  // no temporary file left
+
+  fs::create_symlink("made-by-the-run.json", dir / "link.json");  // dangling
+  outcome = run_varia("run scenes/default.json --quiet --summary " + quoted(dir / "link.json"));
+  CAPTURE(outcome.err);
+  CHECK(outcome.code == 0);
+  CHECK(fs::is_symlink(dir / "link.json"));
+  CHECK(fs::read_symlink(dir / "link.json") == "made-by-the-run.json");
+  REQUIRE(fs::exists(dir / "made-by-the-run.json"));
+  CHECK(json::parse(read_file(dir / "made-by-the-run.json")).contains("steps"));
+}
+
 
 // ---- 3: validation bounded by the scene's size ----------------------------------------------------
 
