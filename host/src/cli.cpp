@@ -178,8 +178,10 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
                             "Example:\n  varia verify scenes/default.json --json checks.json");
   add_scene(verify, o.scene);
   verify->add_option("--json", o.verify_json, "write the checks as JSON here")->type_name("FILE");
-  verify->add_option("--h", o.verify_h, "the step sizes the orders are fitted at, comma-separated (default: chosen "
-                                        "by verify in the asymptotic range above round-off)")
+  verify->add_option("--h", o.verify_h, "the step sizes the orders are fitted at, comma-separated: at least 4, no "
+                                        "two taking the same number of steps to global_order's final time (20 times "
+                                        "the largest step size), none more than 1e8 steps (default: chosen by verify "
+                                        "in the asymptotic range above round-off)")
       ->delimiter(',')
       ->allow_extra_args(false)
       ->type_name("H,H,..");

@@ -152,6 +152,14 @@ Eigen::VectorXd parse_point(const std::string& text, Manifold& manifold, const s
 
 }  // namespace
 
+void check_step_flag(double h, double span, const std::string& span_name) {
+  if (!(h > 0.0) || !std::isfinite(h)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", h));
+  if (h > span) throw InputError(fmt::format("--h: expected step sizes at most {}; found {}", span_name, h));
+  if (span / h > kMaxFlagSteps)
+    throw InputError(fmt::format("--h: expected at most {:g} steps to {}; h = {} gives {:g}", kMaxFlagSteps,
+                                 span_name, h, span / h));
+}
+
 int command_plugins(const CommonOptions& common, bool as_json) {
   Registry registry = make_registry(common);
   std::vector<Refusal> refused;
@@ -223,13 +231,9 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,
                    const std::vector<double>& h) {
   if (!json_file.empty()) check_distinct({{"scene", scene_file}}, {{"--json", json_file}});
-  for (double step : h)
-    if (!(step > 0.0) || !std::isfinite(step)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", step));
-  if (!h.empty() && h.size() < static_cast<std::size_t>(kMinimumFitPoints))
-    throw InputError(fmt::format("--h: expected at least {} step sizes to fit an order to; found {}",
-                                 kMinimumFitPoints, h.size()));
   return with_registry(common, [&](Registry& registry) {
     Prepared prepared = prepare(scene_file, registry);
+    check_fit_steps(prepared.scene, h);
     const auto checks = verify_scene(prepared.scene, prepared.assembly, registry, h);
     fmt::print(results(), "{}", checks_table(checks));
     if (!json_file.empty()) write_json_file(json_file, nlohmann::ordered_json(checks_json(checks)), "--json");

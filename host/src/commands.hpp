@@ -15,6 +15,13 @@ struct CommonOptions {
   std::vector<std::string> plugin_paths;  // --plugin-path, repeatable
 };
 
+// The most steps a run that `cost --h` or `verify --h` asks for may take: those commands repeat
+// their runs and time them, and a step costs microseconds.
+inline constexpr double kMaxFlagSteps = 1e8;
+// A step size given with --h for runs over `span` (named by `span_name` in messages): InputError
+// unless it is a number > 0, at most the span, taking at most kMaxFlagSteps steps over it.
+void check_step_flag(double h, double span, const std::string& span_name);
+
 int command_plugins(const CommonOptions& common, bool json);
 int command_validate(const CommonOptions& common, const std::string& scene_file);
 int command_run(const CommonOptions& common, const std::string& scene_file, const RunOptions& options);

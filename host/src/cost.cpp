@@ -37,9 +37,6 @@ constexpr long kEnergySamples = 1000;
 // single short run is dominated by timer resolution and cold caches.
 constexpr double kShortRun = 0.05;
 constexpr int kMaxRepeats = 20;
-// A run of the sweep takes at most this many steps (`--h` is refused below t_end / kMaxSteps): the
-// sweep repeats its short runs and times every run, and a step costs microseconds.
-constexpr double kMaxSteps = 1e8;
 // The default sweep: the scene's step times 2^2, 2^1, ..., 2^-4 (7 step sizes, 6 halvings).
 constexpr int kSweepAbove = 2, kSweepBelow = 4;
 
@@ -238,17 +235,10 @@ void check_cost_outputs(const std::vector<std::string>& scene_files, const std::
 }
 
 // Every step size of the sweep gives a number of steps the scene reader would accept (at least
-// one step of at most t_end, at most kMaxSteps).
+// one step of at most t_end, at most kMaxFlagSteps).
 void check_step_sizes(const Method& m, const std::vector<double>& flags) {
   const double t_end = final_time(m.scene);
-  for (double h : flags) {
-    if (!(h > 0.0) || !std::isfinite(h)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", h));
-    if (h > t_end)
-      throw InputError(fmt::format("--h: expected step sizes at most t_end = {} of {}; found {}", t_end, m.file, h));
-    if (t_end / h > kMaxSteps)
-      throw InputError(fmt::format("--h: expected at most {:g} steps to t_end = {} of {}; h = {} gives {:g}",
-                                   kMaxSteps, t_end, m.file, h, t_end / h));
-  }
+  for (double h : flags) check_step_flag(h, t_end, fmt::format("t_end = {} of {}", t_end, m.file));
 }
 
 std::string csv_field(const std::string& text) {

@@ -344,6 +344,27 @@ TEST_CASE("ld, cost and the scene reader refuse inputs that gave wrong numbers w
     check_one_error_line(outcome, named);
   }
 }
+TEST_CASE("verify --h refuses repeated, non-positive, too few and too small step sizes with exit 2 naming --h") {
+  TempDir dir;
+  write_file(dir / "s.json", oscillator_scene().dump());
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"0.1,0.1,0.05,0.025", "--h: expected distinct step sizes; 0.1 and 0.1 both take 20 steps to T = 2"},
+      {"0.1,0.05,0.025,0.0125,0.05", "--h: expected distinct step sizes; 0.05 and 0.05 both take 40 steps"},
+      {"0.1,0.05,0.025,0.0250000001", "--h: expected distinct step sizes; 0.025 and 0.0250000001 both take 80"},
+      {"0.1,0.05,0.025,0", "--h: expected numbers > 0; found 0"},
+      {"0.1,0.05,0.025,-0.0125", "--h: expected numbers > 0; found -0.0125"},
+      {"0.1,0.05,0.025", "--h: expected at least 4 distinct step sizes"},
+      {"0.1,0.05,0.025,1e-300", "--h: expected at most 1e+08 steps to T = 2"},
+      {"0.1,0.05,0.025,1e-9", "--h: expected at most 1e+08 steps to T = 2"},
+  };
+  for (const auto& [h, named] : cases) {
+    CAPTURE(h);
+    const auto outcome = run_varia("verify " + quoted(dir / "s.json") + " --h " + h);
+    CHECK(outcome.code == 2);
+    check_one_error_line(outcome, named);
+  }
+}
+
 
 // ---- 10: exit codes --------------------------------------------------------------------------------
 
