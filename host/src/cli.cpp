@@ -141,7 +141,9 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
                   "(datasets t, q, p and one per observable; the scene as the root's attribute 'scene')")
       ->type_name("FILE.csv|FILE.h5");
   run->add_option("--summary", o.run_summary, "write the run record JSON here")->type_name("FILE.json");
-  run->add_option("--plot", o.run_plot, "draw q(t) and the energy error (or p(t)) into this SVG (gnuplot)")
+  run->add_option("--plot", o.run_plot,
+                  "draw q(t) (q0..q2) and the energy error (or p0..p2) into this SVG (gnuplot); a run of more than "
+                  "1000 rows is drawn as the smallest and largest value of each of 1000 stretches of rows")
       ->type_name("FILE.svg");
   run->add_flag("--quiet", o.run.quiet, "no progress line and no human summary");
   run->callback([&] {

@@ -156,6 +156,32 @@ TEST_CASE("plugins --json lists the bundled plugins, a junk file in --plugin-pat
   CHECK(run_varia("run scenes/default.json --quiet --plugin-path '" + dir.path().string() + "'").code == 0);
 }
 
+// The points gnuplot drew (each a use of the point symbol of `pt 7`, the legend's samples included).
+long drawn_points(const std::string& svg) {
+  long count = 0;
+  for (auto at = svg.find("'#gpPt6'"); at != std::string::npos; at = svg.find("'#gpPt6'", at + 1)) ++count;
+  return count;
+}
+
+TEST_CASE("run --plot draws a long run as the least and largest value of 1000 stretches of rows per curve") {
+  TempDir dir;
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "oscillator-galerkin.json"));
+  scene.erase("t_end");
+  scene["step"] = 0.001;
+  scene["steps"] = 100000;  // 100001 rows, about 16 periods
+  scene.erase("output");
+  write_file(dir / "s.json", scene.dump());
+  const auto outcome =
+      run_varia("run '" + (dir / "s.json").string() + "' --quiet --plot '" + (dir / "p.svg").string() + "'");
+  CAPTURE(outcome.err);
+  REQUIRE(outcome.code == 0);
+  // Two curves (q0, E - E0), each of at most 1000 stretches (of 101 rows) drawn as their two
+  // extremes, or one where they are the same row; q0 moves in every stretch.
+  const long points = drawn_points(read_file(dir / "p.svg"));
+  CHECK(points >= 2 * 1000 + 2);
+  CHECK(points <= 2 * 2 * 1000 + 2);
+}
+
 TEST_CASE("a solve that does not converge exits 4, the rows written stay whole, the record names the failure") {
   TempDir dir;
   json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
