@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <stdexcept>
 #include <string_view>
 
@@ -83,7 +84,21 @@ std::string parameters_text(const json& schema) {
   return items.empty() ? "-" : fmt::format("{}", fmt::join(items, ", "));
 }
 
-// One line per plugin (kind, type, version, file), its parameters and properties indented below.
+// One line for each kind and type that more than one file provides: a scene naming it is refused
+// (Registry::find names the files).
+std::vector<std::string> duplicates(const std::vector<PluginRecord>& records) {
+  std::map<std::pair<std::string, std::string>, std::vector<std::string>> files;
+  for (const auto& r : records) files[{r.kind, r.type}].push_back(r.file.string());
+  std::vector<std::string> lines;
+  for (const auto& [name, provided_by] : files)
+    if (provided_by.size() > 1)
+      lines.push_back(fmt::format("{} '{}' is provided by {} files: {}; a scene naming it is refused (exit 3)",
+                                  name.first, name.second, provided_by.size(), fmt::join(provided_by, ", ")));
+  return lines;
+}
+
+// One line per plugin (kind, type, version, file), its parameters and properties indented below;
+// then the types provided twice and the files refused.
 void print_plugins_table(const std::vector<PluginRecord>& records, const std::vector<Refusal>& refused) {
   std::size_t kind_width = 4, type_width = 4, version_width = 7;
   for (const auto& r : records) {
@@ -102,6 +117,10 @@ void print_plugins_table(const std::vector<PluginRecord>& records, const std::ve
     fmt::print(results(), "{}parameters: {}\n", indent, parameters_text(r.parameter_schema));
     if (const auto properties = properties_text(r.properties); !properties.empty())
       fmt::print(results(), "{}properties: {}\n", indent, properties);
+  }
+  if (const auto twice = duplicates(records); !twice.empty()) {
+    fmt::print(results(), "\nduplicates:\n");
+    for (const auto& line : twice) fmt::print(results(), "  {}\n", line);
   }
   if (refused.empty()) return;
   fmt::print(results(), "\nrefused:\n");
@@ -169,7 +188,8 @@ int command_plugins(const CommonOptions& common, bool as_json) {
     return 0;
   }
   fmt::print(results(), "{}\n", plugins_json(records).dump(2));
-  // With --json, stdout holds the array alone; refusals are diagnostics on stderr.
+  // With --json, stdout holds the array alone; duplicates and refusals are diagnostics on stderr.
+  for (const auto& line : duplicates(records)) fmt::print(stderr, "varia: duplicate: {}\n", line);
   for (const auto& r : refused) fmt::print(stderr, "varia: refused {}: {}\n", r.file.string(), r.reason);
   return 0;
 }

@@ -156,6 +156,26 @@ TEST_CASE("plugins --json lists the bundled plugins, a junk file in --plugin-pat
   CHECK(run_varia("run scenes/default.json --quiet --plugin-path '" + dir.path().string() + "'").code == 0);
 }
 
+TEST_CASE("plugins flags a type that two files provide, naming both, in the table and on stderr with --json") {
+  TempDir dir;
+  fs::copy_file(kPluginDir / "lagrangian_pendulum.so", dir / "another-pendulum.so");
+  const std::string flag = " --plugin-path '" + dir.path().string() + "'";
+  // The bundled file (the directory of the program under test), then the copy.
+  const std::string named = "lagrangian 'pendulum' is provided by 2 files: ";
+  const std::string files = "/lagrangian_pendulum.so, " + (dir / "another-pendulum.so").string() +
+                            "; a scene naming it is refused (exit 3)\n";
+  const auto table = run_varia("plugins" + flag);
+  CHECK(table.code == 0);
+  CHECK(contains(table.out, "\nduplicates:\n  " + named));
+  CHECK(contains(table.out, files));
+  const auto listing = run_varia("plugins --json" + flag);
+  CHECK(listing.code == 0);
+  CHECK(contains(listing.err, "varia: duplicate: " + named));
+  CHECK(contains(listing.err, files));
+  CHECK(json::parse(listing.out).is_array());
+  CHECK(run_varia("run scenes/default.json --quiet" + flag).code == 3);
+}
+
 // The points gnuplot drew (each a use of the point symbol of `pt 7`, the legend's samples included).
 long drawn_points(const std::string& svg) {
   long count = 0;
