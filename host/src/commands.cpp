@@ -25,24 +25,6 @@ namespace {
 
 Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
 
-// Runs a command's body with a registry of its own. A plugin fault, or a non-finite value that a
-// plugin returned, is re-thrown naming the plugin (kind, type, file) of the object that failed: the
-// object carries its plugin record (PluginObject::origin, set by Registry::create) into the fault.
-template <class Body>
-int with_registry(const CommonOptions& common, Body&& body) {
-  Registry registry = make_registry(common);
-  try {
-    return body(registry);
-  } catch (const PluginFault& e) {
-    if (e.origin() == nullptr) throw;
-    throw PluginFault(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))));
-  } catch (const NumericalFailure& e) {
-    if (e.origin() == nullptr) throw;
-    throw NumericalFailure(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))),
-                           e.residual());
-  }
-}
-
 // Loads and assembles a scene; every InputError about it is prefixed with the scene's file name.
 struct Prepared {
   Scene scene;
@@ -170,6 +152,20 @@ Eigen::VectorXd parse_point(const std::string& text, Manifold& manifold, const s
 }
 
 }  // namespace
+
+int with_registry(const CommonOptions& common, const std::function<int(Registry&)>& body) {
+  Registry registry = make_registry(common);
+  try {
+    return body(registry);
+  } catch (const PluginFault& e) {
+    if (e.origin() == nullptr) throw;
+    throw PluginFault(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))));
+  } catch (const NumericalFailure& e) {
+    if (e.origin() == nullptr) throw;
+    throw NumericalFailure(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))),
+                           e.residual());
+  }
+}
 
 void check_step_flag(double h, double span, const std::string& span_name) {
   if (!(h > 0.0) || !std::isfinite(h)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", h));

@@ -334,38 +334,39 @@ TimedRun run_timed(const Assembly& a, double h, long steps, Observer* observer) 
 int command_cost(const CommonOptions& common, const std::vector<std::string>& scene_files,
                  const CostOptions& options) {
   check_cost_outputs(scene_files, options.out);
-  Registry registry(Registry::search_path(common.plugin_paths));
-  std::deque<Method> methods;  // a deque: an Assembly stays where it was built
-  for (const auto& file : scene_files) load_method(file, registry, methods);
-  for (const Method& m : methods) check_step_sizes(m, options.h);
+  return with_registry(common, [&](Registry& registry) {
+    std::deque<Method> methods;  // a deque: an Assembly stays where it was built
+    for (const auto& file : scene_files) load_method(file, registry, methods);
+    for (const Method& m : methods) check_step_sizes(m, options.h);
 
-  std::map<std::string, Truth> truths;
-  for (Method& m : methods) {
-    const double h_min = final_time(m.scene) / steps_for(final_time(m.scene), step_sizes(m.scene, options).back());
-    auto [it, fresh] = truths.try_emplace(system_key(m.scene));
-    if (fresh) {
-      progress(options, fmt::format("varia: cost: the truth for {}", m.name));
-      it->second = has_exact_solution(m.assembly) ? exact_truth(m.assembly, final_time(m.scene))
-                                                                 : reference_truth(m, methods, registry, h_min);
+    std::map<std::string, Truth> truths;
+    for (Method& m : methods) {
+      const double t_end = final_time(m.scene), h_min = t_end / steps_for(t_end, step_sizes(m.scene, options).back());
+      auto [it, fresh] = truths.try_emplace(system_key(m.scene));
+      if (fresh) {
+        progress(options, fmt::format("varia: cost: the truth for {}", m.name));
+        it->second = has_exact_solution(m.assembly) ? exact_truth(m.assembly, final_time(m.scene))
+                                                    : reference_truth(m, methods, registry, h_min);
+      }
+      m.truth = &it->second;
     }
-    m.truth = &it->second;
-  }
-  for (std::size_t i = 0; i < methods.size(); ++i) sweep(methods[i], options, static_cast<int>(i),
-                                                         static_cast<int>(methods.size()));
-  progress(options, "");
+    for (std::size_t i = 0; i < methods.size(); ++i)
+      sweep(methods[i], options, static_cast<int>(i), static_cast<int>(methods.size()));
+    progress(options, "");
 
-  json record{{"methods", json::array()}};
-  for (Method& m : methods) {
-    fit(m);
-    record["methods"].push_back(method_record(m));
-    if (!options.quiet) print_table(m);
-  }
-  write_csv(options.out / "cost.csv", methods);
-  write_json_file(options.out / "cost.json", record, "--out");
-  write_plot(options.out / "cost.svg", methods);
-  if (!options.quiet)
-    fmt::print(results(), "wrote {}, cost.svg, cost.json\n", printable((options.out / "cost.csv").string()));
-  return 0;
+    json record{{"methods", json::array()}};
+    for (Method& m : methods) {
+      fit(m);
+      record["methods"].push_back(method_record(m));
+      if (!options.quiet) print_table(m);
+    }
+    write_csv(options.out / "cost.csv", methods);
+    write_json_file(options.out / "cost.json", record, "--out");
+    write_plot(options.out / "cost.svg", methods);
+    if (!options.quiet)
+      fmt::print(results(), "wrote {}, cost.svg, cost.json\n", printable((options.out / "cost.csv").string()));
+    return 0;
+  });
 }
 
 }  // namespace varia::host
