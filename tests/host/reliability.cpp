@@ -261,6 +261,7 @@ TEST_CASE("the run record replaces the file by a rename: a second name of the ol
   CHECK(json::parse(read_file(dir / "r.json")).contains("steps"));
   CHECK(files_in(dir.path(), ".json").size() == 1);  // no temporary file left
 }
+
 TEST_CASE("the run record is written under a 255-byte file name, and through a link to a file not there yet") {
   TempDir dir;
   const fs::path longest = dir / (std::string(250, 'r') + ".json");
@@ -279,7 +280,6 @@ TEST_CASE("the run record is written under a 255-byte file name, and through a l
   REQUIRE(fs::exists(dir / "made-by-the-run.json"));
   CHECK(json::parse(read_file(dir / "made-by-the-run.json")).contains("steps"));
 }
-
 
 // ---- 3: validation bounded by the scene's size ----------------------------------------------------
 
@@ -344,6 +344,7 @@ TEST_CASE("ld, cost and the scene reader refuse inputs that gave wrong numbers w
     check_one_error_line(outcome, named);
   }
 }
+
 TEST_CASE("verify --h refuses repeated, non-positive, too few and too small step sizes with exit 2 naming --h") {
   TempDir dir;
   write_file(dir / "s.json", oscillator_scene().dump());
@@ -364,7 +365,6 @@ TEST_CASE("verify --h refuses repeated, non-positive, too few and too small step
     check_one_error_line(outcome, named);
   }
 }
-
 
 // ---- 10: exit codes --------------------------------------------------------------------------------
 
@@ -401,6 +401,7 @@ TEST_CASE("the scene reader refuses repeated keys, NUL bytes and subnormal numbe
   write_file(dir / "s.json", scene.dump());
   CHECK(run_varia("validate " + quoted(dir / "s.json")).code == 0);
 }
+
 TEST_CASE("a NUL in a plugin type name is shown as \\x00, and the message goes on to list the valid types") {
   TempDir dir;
   json scene = oscillator_scene();
@@ -412,7 +413,6 @@ TEST_CASE("a NUL in a plugin type name is shown as \\x00, and the message goes o
                                 "valid lagrangian types are: ");
   CHECK(contains(outcome.err, "harmonic-oscillator, "));
 }
-
 
 TEST_CASE("messages show control characters escaped and long input cut") {
   TempDir dir;
