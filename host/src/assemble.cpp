@@ -121,6 +121,15 @@ std::shared_ptr<Lagrangian> lagrangian(const Scene& scene, Registry& registry, c
 
 }  // namespace
 
+void check_momentum_size(const Lagrangian& lagrangian, int dim) {
+  const long largest = static_cast<long>(dim) * (dim + 2);
+  if (lagrangian.momentum_size() > largest)
+    throw PluginFault(fmt::format("the Lagrangian declares a momentum map of {} numbers; a symmetry group acting on "
+                                  "a manifold of dimension {} has at most {} generators (dim (dim + 2))",
+                                  lagrangian.momentum_size(), dim, largest),
+                      lagrangian.origin());
+}
+
 bool has_exact_solution(const Assembly& a) { return a.forces.empty() && a.lagrangian->has_exact_solution(); }
 
 Assembly assemble(const Scene& scene, Registry& registry) {
@@ -131,6 +140,7 @@ Assembly assemble(const Scene& scene, Registry& registry) {
   check_initial_state(scene, *a.manifold, scene.manifold.type);
   a.lagrangian = lagrangian(scene, registry, *a.manifold);
   check_lagrangian_fits(scene, *a.lagrangian, *a.manifold);
+  check_momentum_size(*a.lagrangian, a.manifold->dim());
   check_dense_size(scene, *a.lagrangian);
   check_observables(scene, *a.lagrangian, *a.manifold);
   create_forces(scene, registry, a);

@@ -40,6 +40,12 @@ struct Assembly {
 // `verify` and `cost` measure against it; otherwise against a reference run of the same system.
 bool has_exact_solution(const Assembly& assembly);
 
+// A Lagrangian's momentum map has at most dim (dim + 2) numbers, the dimension of the largest Lie
+// group that acts effectively on a manifold of dimension dim (the projective group on RP^dim): a
+// plugin declaring more is at fault (PluginFault from the Lagrangian, naming its plugin), rather
+// than a scene asking for more memory than the machine has. Called by assemble().
+void check_momentum_size(const Lagrangian& lagrangian, int dim);
+
 // Creates the plugin objects and the construction; InputError for a construction that is not
 // available, a Lagrangian that does not fit the manifold, a bad initial state or an observable the
 // system does not define.

@@ -26,18 +26,11 @@ namespace varia::host {
 namespace {
 
 // One line, whatever the message holds: control characters (newlines, terminal escapes, NUL)
-// shown as \xNN, and text quoted from the input cut to a bounded length. Never throws: a closed
-// or full stderr loses the message, not the exit code.
+// shown as \xNN (printable), and text quoted from the input cut to a bounded length. Never throws:
+// a closed or full stderr loses the message, not the exit code.
 void report(const std::string& message) {
   constexpr std::size_t kMaxShown = 2000;
-  std::string line = "varia: error: ";
-  for (std::size_t i = 0; i < message.size() && i < kMaxShown; ++i) {
-    const auto c = static_cast<unsigned char>(message[i]);
-    if (c < 0x20 || c == 0x7f)
-      line += fmt::format("\\x{:02x}", c);
-    else
-      line += static_cast<char>(c);
-  }
+  std::string line = "varia: error: " + printable(std::string_view(message).substr(0, kMaxShown));
   if (message.size() > kMaxShown) line += fmt::format("... ({} more bytes)", message.size() - kMaxShown);
   line += '\n';
   (void)std::fwrite(line.data(), 1, line.size(), stderr);
@@ -148,7 +141,9 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
                   "(datasets t, q, p and one per observable; the scene as the root's attribute 'scene')")
       ->type_name("FILE.csv|FILE.h5");
   run->add_option("--summary", o.run_summary, "write the run record JSON here")->type_name("FILE.json");
-  run->add_option("--plot", o.run_plot, "draw q(t) and the energy error (or p(t)) into this SVG (gnuplot)")
+  run->add_option("--plot", o.run_plot,
+                  "draw q(t) (q0..q2) and the energy error (or p0..p2) into this SVG (gnuplot); a run of more than "
+                  "1000 rows is drawn as the smallest and largest value of each of 1000 stretches of rows")
       ->type_name("FILE.svg");
   run->add_flag("--quiet", o.run.quiet, "no progress line and no human summary");
   run->callback([&] {
@@ -185,8 +180,10 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
                             "Example:\n  varia verify scenes/default.json --json checks.json");
   add_scene(verify, o.scene);
   verify->add_option("--json", o.verify_json, "write the checks as JSON here")->type_name("FILE");
-  verify->add_option("--h", o.verify_h, "the step sizes the orders are fitted at, comma-separated (default: chosen "
-                                        "by verify in the asymptotic range above round-off)")
+  verify->add_option("--h", o.verify_h, "the step sizes the orders are fitted at, comma-separated: at least 4, no "
+                                        "two taking the same number of steps to global_order's final time (20 times "
+                                        "the largest step size), none more than 1e8 steps (default: chosen by verify "
+                                        "in the asymptotic range above round-off)")
       ->delimiter(',')
       ->allow_extra_args(false)
       ->type_name("H,H,..");

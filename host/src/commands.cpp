@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <map>
 #include <stdexcept>
 #include <string_view>
 
@@ -23,24 +24,6 @@ using nlohmann::json;
 namespace {
 
 Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
-
-// Runs a command's body with a registry of its own. A plugin fault, or a non-finite value that a
-// plugin returned, is re-thrown naming the plugin (kind, type, file) of the object that failed: the
-// object carries its plugin record (PluginObject::origin, set by Registry::create) into the fault.
-template <class Body>
-int with_registry(const CommonOptions& common, Body&& body) {
-  Registry registry = make_registry(common);
-  try {
-    return body(registry);
-  } catch (const PluginFault& e) {
-    if (e.origin() == nullptr) throw;
-    throw PluginFault(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))));
-  } catch (const NumericalFailure& e) {
-    if (e.origin() == nullptr) throw;
-    throw NumericalFailure(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))),
-                           e.residual());
-  }
-}
 
 // Loads and assembles a scene; every InputError about it is prefixed with the scene's file name.
 struct Prepared {
@@ -83,7 +66,21 @@ std::string parameters_text(const json& schema) {
   return items.empty() ? "-" : fmt::format("{}", fmt::join(items, ", "));
 }
 
-// One line per plugin (kind, type, version, file), its parameters and properties indented below.
+// One line for each kind and type that more than one file provides: a scene naming it is refused
+// (Registry::find names the files).
+std::vector<std::string> duplicates(const std::vector<PluginRecord>& records) {
+  std::map<std::pair<std::string, std::string>, std::vector<std::string>> files;
+  for (const auto& r : records) files[{r.kind, r.type}].push_back(r.file.string());
+  std::vector<std::string> lines;
+  for (const auto& [name, provided_by] : files)
+    if (provided_by.size() > 1)
+      lines.push_back(fmt::format("{} '{}' is provided by {} files: {}; a scene naming it is refused (exit 3)",
+                                  name.first, name.second, provided_by.size(), fmt::join(provided_by, ", ")));
+  return lines;
+}
+
+// One line per plugin (kind, type, version, file), its parameters and properties indented below;
+// then the types provided twice and the files refused.
 void print_plugins_table(const std::vector<PluginRecord>& records, const std::vector<Refusal>& refused) {
   std::size_t kind_width = 4, type_width = 4, version_width = 7;
   for (const auto& r : records) {
@@ -102,6 +99,10 @@ void print_plugins_table(const std::vector<PluginRecord>& records, const std::ve
     fmt::print(results(), "{}parameters: {}\n", indent, parameters_text(r.parameter_schema));
     if (const auto properties = properties_text(r.properties); !properties.empty())
       fmt::print(results(), "{}properties: {}\n", indent, properties);
+  }
+  if (const auto twice = duplicates(records); !twice.empty()) {
+    fmt::print(results(), "\nduplicates:\n");
+    for (const auto& line : twice) fmt::print(results(), "  {}\n", line);
   }
   if (refused.empty()) return;
   fmt::print(results(), "\nrefused:\n");
@@ -152,6 +153,28 @@ Eigen::VectorXd parse_point(const std::string& text, Manifold& manifold, const s
 
 }  // namespace
 
+int with_registry(const CommonOptions& common, const std::function<int(Registry&)>& body) {
+  Registry registry = make_registry(common);
+  try {
+    return body(registry);
+  } catch (const PluginFault& e) {
+    if (e.origin() == nullptr) throw;
+    throw PluginFault(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))));
+  } catch (const NumericalFailure& e) {
+    if (e.origin() == nullptr) throw;
+    throw NumericalFailure(fmt::format("{}; from {}", e.what(), describe(Registry::record_of(e.origin()))),
+                           e.residual());
+  }
+}
+
+void check_step_flag(double h, double span, const std::string& span_name) {
+  if (!(h > 0.0) || !std::isfinite(h)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", h));
+  if (h > span) throw InputError(fmt::format("--h: expected step sizes at most {}; found {}", span_name, h));
+  if (span / h > kMaxFlagSteps)
+    throw InputError(fmt::format("--h: expected at most {:g} steps to {}; h = {} gives {:g}", kMaxFlagSteps,
+                                 span_name, h, span / h));
+}
+
 int command_plugins(const CommonOptions& common, bool as_json) {
   Registry registry = make_registry(common);
   std::vector<Refusal> refused;
@@ -161,7 +184,8 @@ int command_plugins(const CommonOptions& common, bool as_json) {
     return 0;
   }
   fmt::print(results(), "{}\n", plugins_json(records).dump(2));
-  // With --json, stdout holds the array alone; refusals are diagnostics on stderr.
+  // With --json, stdout holds the array alone; duplicates and refusals are diagnostics on stderr.
+  for (const auto& line : duplicates(records)) fmt::print(stderr, "varia: duplicate: {}\n", line);
   for (const auto& r : refused) fmt::print(stderr, "varia: refused {}: {}\n", r.file.string(), r.reason);
   return 0;
 }
@@ -223,13 +247,9 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,
                    const std::vector<double>& h) {
   if (!json_file.empty()) check_distinct({{"scene", scene_file}}, {{"--json", json_file}});
-  for (double step : h)
-    if (!(step > 0.0) || !std::isfinite(step)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", step));
-  if (!h.empty() && h.size() < static_cast<std::size_t>(kMinimumFitPoints))
-    throw InputError(fmt::format("--h: expected at least {} step sizes to fit an order to; found {}",
-                                 kMinimumFitPoints, h.size()));
   return with_registry(common, [&](Registry& registry) {
     Prepared prepared = prepare(scene_file, registry);
+    check_fit_steps(prepared.scene, h);
     const auto checks = verify_scene(prepared.scene, prepared.assembly, registry, h);
     fmt::print(results(), "{}", checks_table(checks));
     if (!json_file.empty()) write_json_file(json_file, nlohmann::ordered_json(checks_json(checks)), "--json");

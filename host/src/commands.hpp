@@ -3,6 +3,7 @@
 // that cli.cpp maps to exit codes.
 #pragma once
 
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -14,6 +15,18 @@ namespace varia::host {
 struct CommonOptions {
   std::vector<std::string> plugin_paths;  // --plugin-path, repeatable
 };
+
+// Runs a command's body with a registry of its own. A plugin fault, or a non-finite value that a
+// plugin returned, is re-thrown naming the plugin (kind, type, file) of the object that failed: the
+// object carries its plugin record (PluginObject::origin, set by Registry::create) into the fault.
+int with_registry(const CommonOptions& common, const std::function<int(Registry&)>& body);
+
+// The most steps a run that `cost --h` or `verify --h` asks for may take: those commands repeat
+// their runs and time them, and a step costs microseconds.
+inline constexpr double kMaxFlagSteps = 1e8;
+// A step size given with --h for runs over `span` (named by `span_name` in messages): InputError
+// unless it is a number > 0, at most the span, taking at most kMaxFlagSteps steps over it.
+void check_step_flag(double h, double span, const std::string& span_name);
 
 int command_plugins(const CommonOptions& common, bool json);
 int command_validate(const CommonOptions& common, const std::string& scene_file);

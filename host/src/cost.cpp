@@ -37,9 +37,6 @@ constexpr long kEnergySamples = 1000;
 // single short run is dominated by timer resolution and cold caches.
 constexpr double kShortRun = 0.05;
 constexpr int kMaxRepeats = 20;
-// A run of the sweep takes at most this many steps (`--h` is refused below t_end / kMaxSteps): the
-// sweep repeats its short runs and times every run, and a step costs microseconds.
-constexpr double kMaxSteps = 1e8;
 // The default sweep: the scene's step times 2^2, 2^1, ..., 2^-4 (7 step sizes, 6 halvings).
 constexpr int kSweepAbove = 2, kSweepBelow = 4;
 
@@ -189,10 +186,11 @@ std::vector<double> step_sizes(const Scene& scene, const CostOptions& options) {
   return h;
 }
 
-// A progress line on stderr when it is a terminal (spec: "Progress and diagnostics").
+// A progress line on stderr when it is a terminal (spec: "Progress and diagnostics"); the scene's
+// name in it is shown printable.
 void progress(const CostOptions& options, const std::string& text) {
   if (options.quiet || !::isatty(STDERR_FILENO)) return;
-  std::fprintf(stderr, "\r\033[K%s", text.c_str());
+  std::fprintf(stderr, "\r\033[K%s", printable(text).c_str());
   std::fflush(stderr);
 }
 
@@ -207,7 +205,8 @@ void sweep(Method& m, const CostOptions& options, int index, int count) {
       m.rows.push_back(measure(m, t_end / steps, steps));
     } catch (const NumericalFailure& e) {
       progress(options, "");
-      fmt::print(stderr, "varia: cost: {}: h = {:.4g} skipped: {}\n", m.name, t_end / steps, e.what());
+      fmt::print(stderr, "varia: cost: {}: h = {:.4g} skipped: {}\n", printable(m.name), t_end / steps,
+                 printable(e.what()));
     }
   }
   if (m.rows.empty()) throw NumericalFailure(fmt::format("{}: no step size ran to the end", m.file), std::nan(""));
@@ -236,17 +235,10 @@ void check_cost_outputs(const std::vector<std::string>& scene_files, const std::
 }
 
 // Every step size of the sweep gives a number of steps the scene reader would accept (at least
-// one step of at most t_end, at most kMaxSteps).
+// one step of at most t_end, at most kMaxFlagSteps).
 void check_step_sizes(const Method& m, const std::vector<double>& flags) {
   const double t_end = final_time(m.scene);
-  for (double h : flags) {
-    if (!(h > 0.0) || !std::isfinite(h)) throw InputError(fmt::format("--h: expected numbers > 0; found {}", h));
-    if (h > t_end)
-      throw InputError(fmt::format("--h: expected step sizes at most t_end = {} of {}; found {}", t_end, m.file, h));
-    if (t_end / h > kMaxSteps)
-      throw InputError(fmt::format("--h: expected at most {:g} steps to t_end = {} of {}; h = {} gives {:g}",
-                                   kMaxSteps, t_end, m.file, h, t_end / h));
-  }
+  for (double h : flags) check_step_flag(h, t_end, fmt::format("t_end = {} of {}", t_end, m.file));
 }
 
 std::string csv_field(const std::string& text) {
@@ -307,10 +299,12 @@ void write_plot(const std::filesystem::path& file, const std::deque<Method>& met
   write_svg(file, {work, order});
 }
 
+// The method's rows; its name, file and reference (text from the scenes) shown printable.
 void print_table(const Method& m) {
-  fmt::print(results(), "{} ({}): predicted order {}, fitted slope {}\n  error measured against the {}\n", m.name, m.file,
-             m.predicted_order, m.fit.fitted() ? fmt::format("{:.2f} ({} points)", m.fit.slope, m.fit.used) : "-",
-             m.truth->source);
+  fmt::print(results(), "{} ({}): predicted order {}, fitted slope {}\n  error measured against the {}\n",
+             printable(m.name), printable(m.file), m.predicted_order,
+             m.fit.fitted() ? fmt::format("{:.2f} ({} points)", m.fit.slope, m.fit.used) : "-",
+             printable(m.truth->source));
   fmt::print(results(), "  {:>10} {:>8} {:>11} {:>11} {:>10} {:>11} {:>11}\n", "h", "steps", "error", "energy err", "seconds",
              "Newton/step", "evals/step");
   for (const Row& r : m.rows)
@@ -340,37 +334,39 @@ TimedRun run_timed(const Assembly& a, double h, long steps, Observer* observer) 
 int command_cost(const CommonOptions& common, const std::vector<std::string>& scene_files,
                  const CostOptions& options) {
   check_cost_outputs(scene_files, options.out);
-  Registry registry(Registry::search_path(common.plugin_paths));
-  std::deque<Method> methods;  // a deque: an Assembly stays where it was built
-  for (const auto& file : scene_files) load_method(file, registry, methods);
-  for (const Method& m : methods) check_step_sizes(m, options.h);
+  return with_registry(common, [&](Registry& registry) {
+    std::deque<Method> methods;  // a deque: an Assembly stays where it was built
+    for (const auto& file : scene_files) load_method(file, registry, methods);
+    for (const Method& m : methods) check_step_sizes(m, options.h);
 
-  std::map<std::string, Truth> truths;
-  for (Method& m : methods) {
-    const double h_min = final_time(m.scene) / steps_for(final_time(m.scene), step_sizes(m.scene, options).back());
-    auto [it, fresh] = truths.try_emplace(system_key(m.scene));
-    if (fresh) {
-      progress(options, fmt::format("varia: cost: the truth for {}", m.name));
-      it->second = has_exact_solution(m.assembly) ? exact_truth(m.assembly, final_time(m.scene))
-                                                                 : reference_truth(m, methods, registry, h_min);
+    std::map<std::string, Truth> truths;
+    for (Method& m : methods) {
+      const double t_end = final_time(m.scene), h_min = t_end / steps_for(t_end, step_sizes(m.scene, options).back());
+      auto [it, fresh] = truths.try_emplace(system_key(m.scene));
+      if (fresh) {
+        progress(options, fmt::format("varia: cost: the truth for {}", m.name));
+        it->second = has_exact_solution(m.assembly) ? exact_truth(m.assembly, final_time(m.scene))
+                                                    : reference_truth(m, methods, registry, h_min);
+      }
+      m.truth = &it->second;
     }
-    m.truth = &it->second;
-  }
-  for (std::size_t i = 0; i < methods.size(); ++i) sweep(methods[i], options, static_cast<int>(i),
-                                                         static_cast<int>(methods.size()));
-  progress(options, "");
+    for (std::size_t i = 0; i < methods.size(); ++i)
+      sweep(methods[i], options, static_cast<int>(i), static_cast<int>(methods.size()));
+    progress(options, "");
 
-  json record{{"methods", json::array()}};
-  for (Method& m : methods) {
-    fit(m);
-    record["methods"].push_back(method_record(m));
-    if (!options.quiet) print_table(m);
-  }
-  write_csv(options.out / "cost.csv", methods);
-  write_json_file(options.out / "cost.json", record, "--out");
-  write_plot(options.out / "cost.svg", methods);
-  if (!options.quiet) fmt::print(results(), "wrote {}, cost.svg, cost.json\n", (options.out / "cost.csv").string());
-  return 0;
+    json record{{"methods", json::array()}};
+    for (Method& m : methods) {
+      fit(m);
+      record["methods"].push_back(method_record(m));
+      if (!options.quiet) print_table(m);
+    }
+    write_csv(options.out / "cost.csv", methods);
+    write_json_file(options.out / "cost.json", record, "--out");
+    write_plot(options.out / "cost.svg", methods);
+    if (!options.quiet)
+      fmt::print(results(), "wrote {}, cost.svg, cost.json\n", printable((options.out / "cost.csv").string()));
+    return 0;
+  });
 }
 
 }  // namespace varia::host

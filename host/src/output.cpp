@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstdio>
 #include <cstring>
 #include <optional>
@@ -57,12 +58,20 @@ mode_t default_file_mode() {
   return 0666 & ~mask;
 }
 
+// mkstemp's template for the temporary file beside `target`: "." + its name + ".tmp-XXXXXX", the
+// name cut so that the whole stays a valid file name (at most NAME_MAX bytes) for every valid target.
+std::string temporary_template(const fs::path& target) {
+  constexpr std::string_view kSuffix = ".tmp-XXXXXX";
+  const std::string name = target.filename().string().substr(0, NAME_MAX - 1 - kSuffix.size());
+  const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  return (directory / ("." + name + std::string(kSuffix))).string();
+}
+
 // Writes `text` to a temporary file in the directory of `target` and renames it over `target`.
 void replace_file(const fs::path& target, std::string_view text, std::string_view what) {
   struct stat existing {};
   const bool exists = ::stat(target.c_str(), &existing) == 0;
-  const fs::path directory = target.has_parent_path() ? target.parent_path() : fs::path(".");
-  std::string temporary = (directory / ("." + target.filename().string() + ".tmp-XXXXXX")).string();
+  std::string temporary = temporary_template(target);
   const int fd = ::mkstemp(temporary.data());
   if (fd < 0) fail(what, target, "written", errno);
   const auto abandon = [&](int error) {
@@ -81,6 +90,21 @@ void replace_file(const fs::path& target, std::string_view text, std::string_vie
     const int error = errno;
     ::unlink(temporary.c_str());
     fail(what, target, "written", error);
+  }
+}
+
+// The file that writing `file` replaces: `file` itself, or at the end of its symbolic links (also
+// of a link naming a file that is not there yet), followed as open(2) follows them (at most 40).
+fs::path link_target(const fs::path& file, std::string_view what) {
+  constexpr int kMaxLinks = 40;
+  fs::path target = file;
+  for (int links = 0;; ++links) {
+    std::error_code ec;
+    if (!fs::is_symlink(fs::symlink_status(target, ec))) return target;
+    if (links == kMaxLinks) fail(what, file, "written", ELOOP);
+    const fs::path next = fs::read_symlink(target, ec);
+    if (ec) fail(what, file, "written", ec.value());
+    target = next.is_absolute() ? next : target.parent_path() / next;
   }
 }
 
@@ -231,8 +255,19 @@ void write_output(const fs::path& file, std::string_view text, std::string_view 
   std::error_code ec;
   const auto status = fs::status(file, ec);
   if (fs::exists(status) && !fs::is_regular_file(status)) return write_in_place(file, text, what);
-  // A symbolic link keeps pointing where it did: its target is replaced.
-  replace_file(fs::exists(status) ? fs::canonical(file, ec) : file, text, what);
+  replace_file(link_target(file, what), text, what);
+}
+
+std::string printable(std::string_view text) {
+  std::string shown;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte < 0x20 || byte == 0x7f)
+      shown += fmt::format("\\x{:02x}", byte);
+    else
+      shown += c;
+  }
+  return shown;
 }
 
 void write_json_file(const fs::path& file, const nlohmann::ordered_json& document, std::string_view what) {

@@ -57,9 +57,15 @@ class CsvWriter {
 inline std::vector<double> as_vector(const Eigen::VectorXd& x) { return {x.data(), x.data() + x.size()}; }
 
 // Writes `text` to `file` ("-": stdout): a regular file (or a new one) through a temporary file
-// renamed over it, anything else (a device, a pipe) directly. `what` names the output in messages
+// renamed over it, anything else (a device, a pipe) directly. A symbolic link keeps pointing where
+// it did, also when what it names is not there yet: the file it names is written. `what` names the output in messages
 // (e.g. "--summary"). Throws OutputError.
 void write_output(const std::filesystem::path& file, std::string_view text, std::string_view what);
+
+// `text` as a terminal or a one-line message may show it: control characters (newlines, terminal
+// escapes, NUL) written as \xNN, so that text from a scene or a file name can neither move the
+// cursor, nor end a line, nor cut a message short.
+std::string printable(std::string_view text);
 
 // Writes a JSON document (pretty-printed) through write_output.
 void write_json_file(const std::filesystem::path& file, const nlohmann::ordered_json& document,

@@ -26,6 +26,7 @@
 
 #include "crash.hpp"
 #include "json_schema.hpp"
+#include "output.hpp"
 
 namespace fs = std::filesystem;
 
@@ -386,7 +387,9 @@ const PluginRecord& Registry::find(const std::string& kind, const std::string& t
   if (const auto it = loaded_.find(key); it != loaded_.end()) return it->second->record;
   const auto files = files_declaring(kind, type);
   if (files.empty()) check_not_refused(kind, type);
-  if (files.empty()) throw InputError(fmt::format("unknown {} type '{}'; {}", kind, type, valid_types(kind)));
+  // The name as the scene gave it, shown printable: a NUL in it would end the message there.
+  if (files.empty())
+    throw InputError(fmt::format("unknown {} type '{}'; {}", kind, printable(type), valid_types(kind)));
   if (files.size() > 1)
     throw PluginLoadError(fmt::format("{} type '{}' is provided by two files: {} and {}", kind, type,
                                       files[0].string(), files[1].string()));

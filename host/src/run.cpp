@@ -107,34 +107,84 @@ void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, c
   fmt::print(to, "wall time         {:.4f} s\n", outcome.wall_seconds);
 }
 
-// The written rows, kept for `run --plot`: q(t) (up to three coordinates) beside the energy error
-// E - E0 when energy is observed, else p(t).
+// `run --plot` draws at most this many stretches of rows per curve, two points each.
+constexpr long kPlotStretches = 1000;
+
+// One curve of `run --plot`, bounded whatever the number of rows: the rows come in stretches of
+// `per_stretch` consecutive ones, and each stretch is drawn as its smallest and its largest value,
+// in the order they came, so that the line reaches every extreme of the run.
+class DecimatedCurve {
+ public:
+  explicit DecimatedCurve(long per_stretch) : per_stretch_(per_stretch) {}
+  void add(double t, double y) {
+    if (count_ == 0 || y < low_.y) low_ = {t, y};
+    if (count_ == 0 || y > high_.y) high_ = {t, y};
+    if (++count_ == per_stretch_) end_stretch();
+  }
+  Series series(std::string title) {
+    end_stretch();
+    return Series{std::move(title), t_, y_, false};
+  }
+
+ private:
+  struct Point {
+    double t = 0.0, y = 0.0;
+  };
+  void end_stretch() {
+    if (count_ == 0) return;
+    const bool low_first = low_.t <= high_.t;
+    draw(low_first ? low_ : high_);
+    if (low_.t != high_.t) draw(low_first ? high_ : low_);
+    count_ = 0;
+  }
+  void draw(const Point& point) {
+    t_.push_back(point.t);
+    y_.push_back(point.y);
+  }
+  long per_stretch_, count_ = 0;
+  Point low_, high_;
+  std::vector<double> t_, y_;
+};
+
+// The written rows as `run --plot` draws them: q(t) (up to three coordinates) beside the energy
+// error E - E0 when energy is observed, else p(t), each a DecimatedCurve of `rows` rows in at most
+// kPlotStretches stretches.
 class PlotRecorder {
  public:
-  explicit PlotRecorder(bool energy) : energy_(energy) {}
+  PlotRecorder(bool energy, long rows)
+      : energy_(energy), per_stretch_((rows + kPlotStretches - 1) / kPlotStretches) {}
   void record(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& p, const std::vector<double>& values) {
-    const int shown = static_cast<int>(std::min<Eigen::Index>(q.size(), 3));
-    if (coordinates_.empty()) coordinates_.resize(shown), right_.resize(energy_ ? 1 : std::min<Eigen::Index>(p.size(), 3));
-    for (int i = 0; i < shown; ++i) coordinates_[i].x.push_back(t), coordinates_[i].y.push_back(q[i]);
-    for (std::size_t i = 0; i < right_.size(); ++i) {
-      if (energy_ && initial_energy_ == 0.0 && right_[0].x.empty()) initial_energy_ = values[0];
-      right_[i].x.push_back(t);
-      right_[i].y.push_back(energy_ ? values[0] - initial_energy_ : p[static_cast<Eigen::Index>(i)]);
+    if (coordinates_.empty()) {
+      coordinates_.assign(std::min<Eigen::Index>(q.size(), 3), DecimatedCurve(per_stretch_));
+      right_.assign(energy_ ? 1 : std::min<Eigen::Index>(p.size(), 3), DecimatedCurve(per_stretch_));
+      if (energy_) initial_energy_ = values[0];
     }
+    for (std::size_t i = 0; i < coordinates_.size(); ++i) coordinates_[i].add(t, q[static_cast<Eigen::Index>(i)]);
+    for (std::size_t i = 0; i < right_.size(); ++i)
+      right_[i].add(t, energy_ ? values[0] - initial_energy_ : p[static_cast<Eigen::Index>(i)]);
   }
   void write(const std::filesystem::path& file) {
-    for (std::size_t i = 0; i < coordinates_.size(); ++i) coordinates_[i].title = fmt::format("q{}", i);
-    for (std::size_t i = 0; i < right_.size(); ++i) right_[i].title = energy_ ? "E - E0" : fmt::format("p{}", i);
-    write_svg(file, {Panel{"configuration", "t", "q", false, false, coordinates_},
+    std::vector<Series> coordinates, right;
+    for (std::size_t i = 0; i < coordinates_.size(); ++i)
+      coordinates.push_back(coordinates_[i].series(fmt::format("q{}", i)));
+    for (std::size_t i = 0; i < right_.size(); ++i)
+      right.push_back(right_[i].series(energy_ ? "E - E0" : fmt::format("p{}", i)));
+    write_svg(file, {Panel{"configuration", "t", "q", false, false, coordinates},
                      Panel{energy_ ? "energy error" : "momentum", "t", energy_ ? "E(t) - E(0)" : "p", false, false,
-                           right_}});
+                           right}});
   }
 
  private:
   bool energy_;
+  long per_stretch_;
   double initial_energy_ = 0.0;
-  std::vector<Series> coordinates_, right_;
+  std::vector<DecimatedCurve> coordinates_, right_;
 };
+
+// The rows a run writes (spec "output.every"): step 0, every k-th step, and the last step.
+long written_rows(const Scene& scene) {
+  return scene.steps / scene.output_every + 1 + (scene.steps % scene.output_every != 0 ? 1 : 0);
+}
 
 // The run: the scene's trajectory (core/trajectory.hpp), observed and written at every step the
 // scene observes or writes, the steps between taken in stretches (quiet_steps).
@@ -149,7 +199,7 @@ class Stepper {
       h5_ = std::make_unique<Hdf5Writer>(*options.out, scene.text);
     else if (options.out)
       csv_ = std::make_unique<CsvWriter>(*options.out);
-    if (options.plot) plot_ = std::make_unique<PlotRecorder>(scene.observe.energy);
+    if (options.plot) plot_ = std::make_unique<PlotRecorder>(scene.observe.energy, written_rows(scene));
   }
 
   PlotRecorder* plot() { return plot_.get(); }

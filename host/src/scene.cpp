@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <limits>
 #include <map>
 
 #include "json_reader.hpp"
@@ -48,6 +49,21 @@ long steps_of(const json& document, double t0, double step) {
     throw InputError(fmt::format(
         "/t_end: expected a whole number of steps of {} (t_end / step = {:.17g}); found {}", step, ratio, t_end));
   return steps;
+}
+
+// The times of a run, t0 + k h, are told apart to a thousandth of a step: near the largest of
+// them, doubles are at most kTimeResolution h apart. Beyond that the written times are uneven, and
+// once doubles are h apart they repeat (initial.t = 1e16 with h = 0.1).
+constexpr double kTimeResolution = 1e-3;
+
+void check_time_resolution(double t0, double step, long steps) {
+  const double t = std::max(std::abs(t0), std::abs(t0 + static_cast<double>(steps) * step));
+  const double spacing = std::nextafter(t, std::numeric_limits<double>::infinity()) - t;
+  if (!(spacing <= kTimeResolution * step))  // also a run whose last time overflows
+    throw InputError(fmt::format("/initial/t: expected a start time at which the times t0 + k h of the run stay "
+                                 "apart: near t = {:g} doubles are {:g} apart, and the step is {:g} (at most {:g} "
+                                 "of a step is taken); found {:g}",
+                                 t, spacing, step, kTimeResolution, t0));
 }
 
 // The construction checks and reads its own keys; the generic parts (quadrature, one-step method,
@@ -115,6 +131,7 @@ Scene parse_scene(const json& document) {
   const json& initial = document["initial"];
   scene.t0 = initial.value("t", 0.0);
   scene.steps = steps_of(document, scene.t0, scene.step);
+  check_time_resolution(scene.t0, scene.step, scene.steps);
   read_observe(document, scene);
   if (document.contains("output")) scene.output_every = document["output"].value("every", 1);
   scene.q = initial["q"].get<std::vector<double>>();

@@ -7,8 +7,10 @@
 #include <cstdlib>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <numeric>
 
+#include "commands.hpp"
 #include "constructions/parts.hpp"
 #include "registry.hpp"
 #include "varia/core/trajectory.hpp"
@@ -368,11 +370,17 @@ std::string reference_state(Context& x, double T, long steps, std::vector<double
                      T / (2 * steps), uncertainty);
 }
 
-// The slope of the error at T = 20 steps of the scene against h (each h made a whole number of
+// The largest step size of global_order's fit: the scene's step or the largest given one.
+double top_step(const Scene& scene, const std::vector<double>& given_h) {
+  double top = scene.step;
+  for (double h : given_h) top = std::max(top, h);
+  return top;
+}
+
+// The slope of the error at T = kOrderSpan top steps against h (each h made a whole number of
 // steps to T).
 PropertyCheck global_order(Context& x) {
-  double top = x.scene.step;
-  for (double h : x.given_h) top = std::max(top, h);
+  const double top = top_step(x.scene, x.given_h);
   const double T = kOrderSpan * top;
   std::vector<double> qe, pe, q, p;
   double uncertainty = 0.0;
@@ -517,6 +525,23 @@ PropertyCheck energy_bounded(Context& x, const std::vector<LongRun>& runs) {
 }
 
 }  // namespace
+
+void check_fit_steps(const Scene& scene, const std::vector<double>& h) {
+  if (h.empty()) return;
+  const double T = kOrderSpan * top_step(scene, h);
+  const std::string span = fmt::format("T = {:g} (global_order's final time, {:g} times the largest step size)", T,
+                                       kOrderSpan);
+  std::map<long, double> by_steps;  // the number of steps to T: the step size that gives it
+  for (double step : h) {
+    check_step_flag(step, T, span);
+    if (const auto [given, fresh] = by_steps.emplace(std::lround(T / step), step); !fresh)
+      throw InputError(fmt::format("--h: expected distinct step sizes; {} and {} both take {} steps to {}",
+                                   given->second, step, given->first, span));
+  }
+  if (h.size() < static_cast<std::size_t>(kMinimumFitPoints))
+    throw InputError(fmt::format("--h: expected at least {} distinct step sizes to fit an order to; found {}",
+                                 kMinimumFitPoints, h.size()));
+}
 
 bool PropertyCheck::failed() const {
   const bool predicted_to_hold = predicted.is_number() || (predicted.is_boolean() && predicted.get<bool>());

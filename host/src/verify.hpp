@@ -29,7 +29,15 @@ struct PropertyCheck {
   bool unmeasured() const;
 };
 
-// `h`: the step sizes the orders are fitted at (varia verify --h); empty: verify chooses them.
+// Refuses (InputError naming --h) the step sizes given with `verify --h` unless each is accepted
+// by check_step_flag over global_order's final time (kOrderSpan steps of the largest step size,
+// the scene's or a given one), no two give the same number of steps to it (a repeated step size
+// is one point of a fit, not two), and there are at least kMinimumFitPoints. Empty: accepted
+// (verify chooses them).
+void check_fit_steps(const Scene& scene, const std::vector<double>& h);
+
+// `h`: the step sizes the orders are fitted at (varia verify --h, checked by check_fit_steps);
+// empty: verify chooses them.
 std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& assembly, Registry& registry,
                                         const std::vector<double>& h = {});
 nlohmann::json checks_json(const std::vector<PropertyCheck>& checks);

@@ -64,6 +64,8 @@ const std::map<std::string, std::string> kBadScenes{
     {"steps-zero.json", "/steps: expected an integer >= 1"},
     {"t_end-not-whole-steps.json", "/t_end: expected a whole number of steps"},
     {"t_end-too-far.json", "/t_end: expected at most 1e+12 steps"},
+    {"start-time-too-large.json", "/initial/t: expected a start time at which the times t0 + k h of the run stay "
+                                  "apart: near t = 1e+16 doubles are 2 apart, and the step is 0.1"},
     // inconsistent: both, neither, sizes, states
     {"momentum-without-symmetry.json", "/observe: expected no \"momentum\""},
     {"spring-between-one-particle.json", "/system/lagrangian/terms/2: parameter 'between' must name two different particles (the spring plugin effect_spring.so)"},

@@ -156,6 +156,52 @@ TEST_CASE("plugins --json lists the bundled plugins, a junk file in --plugin-pat
   CHECK(run_varia("run scenes/default.json --quiet --plugin-path '" + dir.path().string() + "'").code == 0);
 }
 
+TEST_CASE("plugins flags a type that two files provide, naming both, in the table and on stderr with --json") {
+  TempDir dir;
+  fs::copy_file(kPluginDir / "lagrangian_pendulum.so", dir / "another-pendulum.so");
+  const std::string flag = " --plugin-path '" + dir.path().string() + "'";
+  // The bundled file (the directory of the program under test), then the copy.
+  const std::string named = "lagrangian 'pendulum' is provided by 2 files: ";
+  const std::string files = "/lagrangian_pendulum.so, " + (dir / "another-pendulum.so").string() +
+                            "; a scene naming it is refused (exit 3)\n";
+  const auto table = run_varia("plugins" + flag);
+  CHECK(table.code == 0);
+  CHECK(contains(table.out, "\nduplicates:\n  " + named));
+  CHECK(contains(table.out, files));
+  const auto listing = run_varia("plugins --json" + flag);
+  CHECK(listing.code == 0);
+  CHECK(contains(listing.err, "varia: duplicate: " + named));
+  CHECK(contains(listing.err, files));
+  CHECK(json::parse(listing.out).is_array());
+  CHECK(run_varia("run scenes/default.json --quiet" + flag).code == 3);
+}
+
+// The points gnuplot drew (each a use of the point symbol of `pt 7`, the legend's samples included).
+long drawn_points(const std::string& svg) {
+  long count = 0;
+  for (auto at = svg.find("'#gpPt6'"); at != std::string::npos; at = svg.find("'#gpPt6'", at + 1)) ++count;
+  return count;
+}
+
+TEST_CASE("run --plot draws a long run as the least and largest value of 1000 stretches of rows per curve") {
+  TempDir dir;
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "oscillator-galerkin.json"));
+  scene.erase("t_end");
+  scene["step"] = 0.001;
+  scene["steps"] = 100000;  // 100001 rows, about 16 periods
+  scene.erase("output");
+  write_file(dir / "s.json", scene.dump());
+  const auto outcome =
+      run_varia("run '" + (dir / "s.json").string() + "' --quiet --plot '" + (dir / "p.svg").string() + "'");
+  CAPTURE(outcome.err);
+  REQUIRE(outcome.code == 0);
+  // Two curves (q0, E - E0), each of at most 1000 stretches (of 101 rows) drawn as their two
+  // extremes, or one where they are the same row; q0 moves in every stretch.
+  const long points = drawn_points(read_file(dir / "p.svg"));
+  CHECK(points >= 2 * 1000 + 2);
+  CHECK(points <= 2 * 2 * 1000 + 2);
+}
+
 TEST_CASE("a solve that does not converge exits 4, the rows written stay whole, the record names the failure") {
   TempDir dir;
   json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));

@@ -84,6 +84,25 @@ TEST_CASE("cost names a method by the scene's \"name\" and runs the step sizes g
   CHECK(sweeps.at("Stormer-Verlet").h == std::vector<double>{0.02, 0.01, 0.005});
 }
 
+TEST_CASE("cost shows a scene's name with terminal escapes as \\xNN in its table, and writes it as it is to cost.json") {
+  TempDir dir;
+  const std::string name = "pendulum\x1b]0;title\x07\x1b[2J\r";
+  nlohmann::json scene = nlohmann::json::parse(read_file(kSourceDir / "scenes/pendulum-galerkin-s1.json"));
+  scene["name"] = name;
+  write_file(dir / "named.json", scene.dump());
+  const auto outcome = run_varia("cost '" + (dir / "named.json").string() + "' --h 0.2,0.1,0.05,0.025 --out '" +
+                                 dir.path().string() + "'");
+  CAPTURE(outcome.err);
+  REQUIRE(outcome.code == 0);
+  CHECK(contains(outcome.out, "pendulum\\x1b]0;title\\x07\\x1b[2J\\x0d ("));
+  for (const char control : {'\x1b', '\x07', '\r'}) {
+    CHECK(outcome.out.find(control) == std::string::npos);
+    CHECK(outcome.err.find(control) == std::string::npos);
+  }
+  const auto record = nlohmann::json::parse(read_file(dir / "cost.json"));
+  CHECK(record["methods"][0]["method"] == name);
+}
+
 TEST_CASE("cost on forced scenes (damping, periodic force, both, galerkin and shooting) fits the predicted order 4 "
           "against a reference run of the forced system") {
   TempDir dir;

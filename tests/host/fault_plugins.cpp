@@ -7,9 +7,13 @@
 
 #include <unistd.h>
 
+#include <limits>
 #include <nlohmann/json.hpp>
 
+#include "assemble.hpp"
+#include "commands.hpp"
 #include "host/support.hpp"
+#include "registry.hpp"
 #include "varia/core/plugin_object.hpp"
 
 namespace varia::test {
@@ -320,6 +324,37 @@ TEST_CASE("what a plugin prints goes to stderr: stdout holds the results alone")
   CHECK(listing.code == 0);
   CHECK(contains(listing.err, "prints plugin: puts"));
   CHECK(json::parse(listing.out).is_array());
+}
+
+// A Lagrangian of one degree of freedom declaring a momentum map of 2^31 - 1 numbers, made here
+// rather than built as a plugin file; its origin is the record a registry would give it.
+class HugeMomentum final : public Lagrangian {
+ public:
+  int position_size() const noexcept override { return 1; }
+  int velocity_size() const noexcept override { return 1; }
+  Status evaluate(const double*, const double*, double*, double*, double*) noexcept override { return nullptr; }
+  int momentum_size() const noexcept override { return std::numeric_limits<int>::max(); }
+};
+
+TEST_CASE("a Lagrangian declaring a momentum map larger than any group acting on its manifold is a plugin fault "
+          "naming its file") {
+  const host::PluginRecord record{"/plugins/lagrangian_huge_momentum.so", "lagrangian", "huge-momentum", "0.0.1",
+                                  {}, {}, {}};
+  HugeMomentum lagrangian;
+  lagrangian.set_origin(&record);
+  std::string message = "(nothing thrown)";
+  try {
+    // As every command checks it when it assembles the scene, inside the registry's naming of faults.
+    host::with_registry({}, [&](host::Registry&) {
+      host::check_momentum_size(lagrangian, 1);
+      return 0;
+    });
+  } catch (const PluginFault& e) {
+    message = e.what();
+  }
+  CHECK(message == "the Lagrangian declares a momentum map of 2147483647 numbers; a symmetry group acting on a "
+                   "manifold of dimension 1 has at most 3 generators (dim (dim + 2)); from lagrangian "
+                   "'huge-momentum' (/plugins/lagrangian_huge_momentum.so)");
 }
 
 }  // namespace

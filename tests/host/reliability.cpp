@@ -262,6 +262,25 @@ TEST_CASE("the run record replaces the file by a rename: a second name of the ol
   CHECK(files_in(dir.path(), ".json").size() == 1);  // no temporary file left
 }
 
+TEST_CASE("the run record is written under a 255-byte file name, and through a link to a file not there yet") {
+  TempDir dir;
+  const fs::path longest = dir / (std::string(250, 'r') + ".json");
+  auto outcome = run_varia("run scenes/default.json --quiet --summary " + quoted(longest));
+  CAPTURE(outcome.err);
+  CHECK(outcome.code == 0);
+  CHECK(json::parse(read_file(longest)).contains("steps"));
+  CHECK(std::distance(fs::directory_iterator(dir.path()), fs::directory_iterator()) == 1);  // no temporary file left
+
+  fs::create_symlink("made-by-the-run.json", dir / "link.json");  // dangling
+  outcome = run_varia("run scenes/default.json --quiet --summary " + quoted(dir / "link.json"));
+  CAPTURE(outcome.err);
+  CHECK(outcome.code == 0);
+  CHECK(fs::is_symlink(dir / "link.json"));
+  CHECK(fs::read_symlink(dir / "link.json") == "made-by-the-run.json");
+  REQUIRE(fs::exists(dir / "made-by-the-run.json"));
+  CHECK(json::parse(read_file(dir / "made-by-the-run.json")).contains("steps"));
+}
+
 // ---- 3: validation bounded by the scene's size ----------------------------------------------------
 
 TEST_CASE("a scene of many repeated observables is refused at the first repeat, in bounded time") {
@@ -326,6 +345,27 @@ TEST_CASE("ld, cost and the scene reader refuse inputs that gave wrong numbers w
   }
 }
 
+TEST_CASE("verify --h refuses repeated, non-positive, too few and too small step sizes with exit 2 naming --h") {
+  TempDir dir;
+  write_file(dir / "s.json", oscillator_scene().dump());
+  const std::vector<std::pair<std::string, std::string>> cases{
+      {"0.1,0.1,0.05,0.025", "--h: expected distinct step sizes; 0.1 and 0.1 both take 20 steps to T = 2"},
+      {"0.1,0.05,0.025,0.0125,0.05", "--h: expected distinct step sizes; 0.05 and 0.05 both take 40 steps"},
+      {"0.1,0.05,0.025,0.0250000001", "--h: expected distinct step sizes; 0.025 and 0.0250000001 both take 80"},
+      {"0.1,0.05,0.025,0", "--h: expected numbers > 0; found 0"},
+      {"0.1,0.05,0.025,-0.0125", "--h: expected numbers > 0; found -0.0125"},
+      {"0.1,0.05,0.025", "--h: expected at least 4 distinct step sizes"},
+      {"0.1,0.05,0.025,1e-300", "--h: expected at most 1e+08 steps to T = 2"},
+      {"0.1,0.05,0.025,1e-9", "--h: expected at most 1e+08 steps to T = 2"},
+  };
+  for (const auto& [h, named] : cases) {
+    CAPTURE(h);
+    const auto outcome = run_varia("verify " + quoted(dir / "s.json") + " --h " + h);
+    CHECK(outcome.code == 2);
+    check_one_error_line(outcome, named);
+  }
+}
+
 // ---- 10: exit codes --------------------------------------------------------------------------------
 
 TEST_CASE("cost --out naming a file is bad input (exit 2)") {
@@ -360,6 +400,18 @@ TEST_CASE("the scene reader refuses repeated keys, NUL bytes and subnormal numbe
   scene["steps"] = 20.0;
   write_file(dir / "s.json", scene.dump());
   CHECK(run_varia("validate " + quoted(dir / "s.json")).code == 0);
+}
+
+TEST_CASE("a NUL in a plugin type name is shown as \\x00, and the message goes on to list the valid types") {
+  TempDir dir;
+  json scene = oscillator_scene();
+  scene["system"]["lagrangian"]["type"] = std::string("harmonic\0oscillator", 19);
+  write_file(dir / "s.json", scene.dump());
+  const auto outcome = run_varia("validate " + quoted(dir / "s.json"));
+  CHECK(outcome.code == 2);
+  check_one_error_line(outcome, "/system/lagrangian/type: unknown lagrangian type 'harmonic\\x00oscillator'; "
+                                "valid lagrangian types are: ");
+  CHECK(contains(outcome.err, "harmonic-oscillator, "));
 }
 
 TEST_CASE("messages show control characters escaped and long input cut") {
