@@ -357,5 +357,35 @@ TEST_CASE("a Lagrangian declaring a momentum map larger than any group acting on
                    "'huge-momentum' (/plugins/lagrangian_huge_momentum.so)");
 }
 
+// A manifold whose structure no construction serves yet (a homogeneous space, S2:
+// tests/fault_plugins/unserved_sphere.cpp) is refused once, at /system/manifold, by validate and
+// for every construction, before anything else is made of it; it is not taken for a Lie group.
+TEST_CASE("a manifold of a structure no construction serves is refused at /system/manifold, exit 2") {
+  const FaultDirectory faults;
+  const json methods[] = {
+      {{"construction", "galerkin"}, {"degree", 1}, {"quadrature", {{"type", "trapezoid"}}}},
+      {{"construction", "shooting"}, {"one_step", {{"type", "rk4"}}}, {"quadrature", {{"type", "simpson"}}}},
+  };
+  for (const json& method : methods) {
+    json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
+    scene["system"]["manifold"] = {{"type", "unserved-sphere"}};
+    scene["method"] = method;
+    scene["initial"] = {{"q", {0.0, 0.0, 1.0}}, {"p", {0.0, 0.0}}};
+    scene.erase("observe");
+    const auto file = faults.dir / "sphere.json";
+    write_file(file, scene.dump());
+    for (const char* command : {"validate", "run"}) {
+      CAPTURE(method.dump());
+      CAPTURE(command);
+      const std::string quiet = std::string(command) == "run" ? " --quiet " : " ";
+      const auto outcome = run_varia(std::string(command) + " '" + file.string() + "'" + quiet + faults.flag());
+      CAPTURE(outcome.err);
+      CHECK(outcome.code == 2);
+      CHECK(contains(outcome.err, "/system/manifold: the unserved-sphere manifold is a homogeneous space, and the "
+                                  "constructions serve vector spaces and Lie groups"));
+    }
+  }
+}
+
 }  // namespace
 }  // namespace varia::test
