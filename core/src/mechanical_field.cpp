@@ -57,10 +57,10 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
     throw std::invalid_argument(
         "the tangent form (q, v) of the Euler-Lagrange field with a configuration-dependent mass matrix needs "
         "the Lagrangian's Hessian at jets of at least 2 variables (Lagrangian::hessian_jet: the acceleration "
-        "M^{-1} (L_q - L_vq v) and its second-order jets need L's derivatives to fourth order); this one declares "
+        "M^{-1} (L_q - L_vq v) and its second-order jets need L's derivatives to fourth order); this one has "
         "no constant mass matrix and gives no Hessian at jets (models derived from sdk::AutodiffLagrangian give "
-        "it on its fixed-size path, docs/shooting.md). Integrate in (q, p): the shooting construction's "
-        "\"form\": \"hamiltonian\"");
+        "it for at most sdk::kStackVariables = 18 position and velocity numbers together, docs/shooting.md). "
+        "Integrate in (q, p): the shooting construction's \"form\": \"hamiltonian\"");
   v_.setZero();
 }
 

@@ -28,17 +28,9 @@ Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingFo
                                 "(the Euler-Lagrange field on TQ) only");
   if (!lagrangian.evaluates_at_jets())
     throw std::invalid_argument("the shooting construction propagates jets through the Euler-Lagrange field, and "
-                                "this Lagrangian (" +
-                                std::to_string(lagrangian.position_size() + lagrangian.velocity_size()) +
-                                " position and velocity numbers) does not evaluate at jets (models derived from "
-                                "sdk::AutodiffLagrangian do for at most sdk::kStackVariables = 18 position and "
-                                "velocity numbers together, sdk::TermwiseLagrangian at any size, and a composite "
-                                "Lagrangian whose effects all do: Effect::gradient_jet)");
-  if (!manifold.is_vector_space() && 2 * manifold.dim() > kMaxJetVariables)
-    throw std::invalid_argument("the shooting construction on a Lie group differentiates the propagation with "
-                                "jets of at most " + std::to_string(kMaxJetVariables) +
-                                " variables (eta, w0) in one pass: it takes groups of dim <= " +
-                                std::to_string(kMaxJetVariables / 2));
+                                "this Lagrangian does not evaluate at jets (Lagrangian::gradient_jet: models "
+                                "derived from sdk::AutodiffLagrangian or sdk::TermwiseLagrangian do, and a "
+                                "composite Lagrangian whose effects all do: Effect::gradient_jet)");
   return lagrangian;
 }
 
@@ -66,7 +58,8 @@ ShootingForm shooting_form(const std::string& name) {
 ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian,
                                                        Quadrature& quadrature,
                                                        OneStepMethod& method, ShootingForm form,
-                                                       SolverOptions options, std::vector<Force*> forces)
+                                                       SolverOptions options, std::vector<Force*> forces,
+                                                       int jet_capacity)
     : manifold_(manifold),
       lagrangian_(checked(manifold, lagrangian, form)),
       forces_(std::move(forces), manifold.point_size(), manifold.dim()),
@@ -120,7 +113,10 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   alpha_.resize(2 * n_);
   zero_.assign(std::max(m_, n_), 0.0);
   slot_.resize(2 * n_);
-  plan_passes(field_->jet_variables());
+  if (jet_capacity < 2 || jet_capacity > kMaxJetVariables)
+    throw std::invalid_argument("the shooting construction's jets hold 2 to " + std::to_string(kMaxJetVariables) +
+                                " variables");
+  plan_passes(std::min(jet_capacity, field_->jet_variables()));
   acceleration_.resize(n_);
   gradient_.resize(m_ + n_);
   boundary_.resize(n_);
@@ -168,7 +164,7 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
 }
 
 // The passes of a propagation. When the jets hold all 2n numbers of x = (eta, w0), one pass gives
-// every derivative (R^1..R^6 and the Lie groups). Otherwise (R^n, n > capacity / 2), the first
+// every derivative (dimensions 1..6). Otherwise (n > capacity / 2), the first
 // derivatives come from passes over consecutive blocks of `capacity` numbers, and Phi's columns in
 // w0, the only second derivatives the solve needs (shooting.hpp), from passes over a block of
 // eta with a block of w0 and over two blocks of w0 (capacity / 2 numbers each): of the order of
@@ -275,12 +271,12 @@ void ShootingDiscreteLagrangian::start_point(const double* q0) {
                         {chart_value_.data(), chart_gradient_.data(), chart_hessian_.data()}, {}),
         "manifold chart");
   for (int r = 0; r < m_; ++r) {
-    Jet2& q = state_[r] = Jet2::variable(chart_value_[r], V, 0);
-    q.gradient.setZero();
-    q.hessian.setZero();
+    Jet2& q = state_[r] = seeded(chart_value_[r], -1);
     for (int a = 0; a < n_; ++a) {
-      q.gradient(a) = chart_gradient_[r * V + a];
-      for (int b = 0; b < n_; ++b) q.hessian(a, b) = chart_hessian_[(r * V + a) * V + b];
+      if (slot_[a] < 0) continue;
+      q.gradient(slot_[a]) = chart_gradient_[r * V + a];
+      for (int b = 0; b < n_; ++b)
+        if (slot_[b] >= 0) q.hessian(slot_[a], slot_[b]) = chart_hessian_[(r * V + a) * V + b];
     }
   }
 }
@@ -354,11 +350,8 @@ void ShootingDiscreteLagrangian::boundary() {
                                     {local_value_.data(), local_gradient_.data(), local_hessian_.data()}),
         "manifold local_derivatives");
   // The chain rule from the point's jets: B_r = sum_k dB_r/dq_k q_k (first and second order).
-  const int V = 2 * n_;
   for (int r = 0; r < n_; ++r) {
-    Jet2& b = boundary_[r] = Jet2::variable(local_value_[r], V, 0);
-    b.gradient.setZero();
-    b.hessian.setZero();
+    Jet2& b = boundary_[r] = seeded(local_value_[r], -1);
     for (int k = 0; k < m_; ++k) {
       const Jet2& q = state_[k];
       if (q.constant()) continue;

@@ -132,3 +132,30 @@ TEST_CASE("shooting on SO(3) refuses the type-2 form") {
   CHECK_THROWS_AS(ShootingDiscreteLagrangian(group, p.top, rule, *method, ShootingForm::type_2, SolverOptions{}),
                   std::invalid_argument);
 }
+
+TEST_CASE("shooting on SO(3) in passes (jets of 2 and 4 variables instead of one pass of 6, as on a group of "
+          "dimension above 6): the trajectory, L_d and its derivatives are the one-pass ones to round-off") {
+  Rotations group;
+  Problem p = heavy_top();
+  for (Composition& c : compositions()) {
+    CAPTURE(c.name);
+    ShootingDiscreteLagrangian one_pass(group, p.top, c.rule, *c.method, ShootingForm::lagrangian, SolverOptions{});
+    const State reference = integrate(one_pass, p.start, 0.05, 20);
+    for (int capacity : {2, 4}) {
+      CAPTURE(capacity);
+      ShootingDiscreteLagrangian passes(group, p.top, c.rule, *c.method, ShootingForm::lagrangian, SolverOptions{},
+                                        {}, capacity);
+      const State state = integrate(passes, p.start, 0.05, 20);
+      CHECK(distance(state, reference) < 1e-13);
+      CHECK(passes.solver_statistics().max_iterations <= one_pass.solver_statistics().max_iterations);
+      const State next = integrate(one_pass, p.start, 0.1, 1);
+      double a = 0.0, b = 0.0;
+      Vector3d a1, a2, b1, b2;
+      one_pass.evaluate(p.start.data(), next.data(), 0.1, &a, a1.data(), a2.data());
+      passes.evaluate(p.start.data(), next.data(), 0.1, &b, b1.data(), b2.data());
+      CHECK(std::abs(a - b) < 1e-14);
+      CHECK((a1 - b1).norm() < 1e-13);
+      CHECK((a2 - b2).norm() < 1e-13);
+    }
+  }
+}

@@ -75,7 +75,6 @@ const std::map<std::string, std::string> kBadScenes{
     {"reduced-se3-spring.json", "/method/reduced: the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group"},
     {"reduced-on-rn.json", "/method/reduced: the reduced (Euler-Poincare) form is for Lie groups"},
     {"reduced-with-shooting.json", "/method/reduced: unknown key 'reduced'; the keys allowed here are: construction, form"},
-    {"shooting-dense-autodiff-above-18.json", "/method: the shooting construction propagates jets through the Euler-Lagrange field, and this Lagrangian (20 position and velocity numbers) does not evaluate at jets (models derived from sdk::AutodiffLagrangian do for at most sdk::kStackVariables = 18"},
     {"so3-not-orthogonal.json", "/initial/q: expected a point of SO3: R is not orthogonal"},
     {"so3-q-size.json", "/initial/q: expected 9 numbers"},
     {"so3-reflection.json", "/initial/q: expected a point of SO3: R is a reflection, not a rotation"},

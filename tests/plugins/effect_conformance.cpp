@@ -295,7 +295,7 @@ TEST_CASE("the effect suite refuses an effect whose gradient at jets has wrong d
   auto method = varia::testing::rk4();
   CHECK_THROWS_WITH_AS(varia::ShootingDiscreteLagrangian(line, composite, rule, method, varia::ShootingForm::lagrangian,
                                                          varia::SolverOptions{}),
-                       doctest::Contains("position and velocity numbers) does not evaluate at jets"), std::invalid_argument);
+                       doctest::Contains("this Lagrangian does not evaluate at jets"), std::invalid_argument);
 }
 
 TEST_SUITE("long") {

@@ -160,3 +160,28 @@ TEST_CASE("shooting on the 60-DOF morse chain (rk4 + Simpson, lagrangian form, t
   CAPTURE(J.transpose());
   CHECK((J - J0).lpNorm<Eigen::Infinity>() <= 1e-14 * (1.0 + J0.lpNorm<Eigen::Infinity>()));
 }
+
+TEST_CASE("shooting on a chain written as one dense autodiff model above the SDK's stack size (5 particles, 20 "
+          "numbers, its gradient at jets over the workspace's dual numbers, the sensitivities in passes): the "
+          "steps of the term-wise plugin, in the lagrangian and hamiltonian forms") {
+  MorseChainParameters p;
+  p.particles = 5;
+  const auto chain = plugin_chain(p);
+  varia::testing::DenseMorseChain dense(p);
+  const int n = 2 * p.particles;
+  varia::testing::FlatSpace space(n);
+  auto rule = varia::testing::simpson();
+  auto method = varia::testing::rk4();
+  for (auto form : {varia::ShootingForm::lagrangian, varia::ShootingForm::hamiltonian}) {
+    varia::ShootingDiscreteLagrangian termwise(space, *chain, rule, method, form, {});
+    varia::ShootingDiscreteLagrangian one_model(space, dense, rule, method, form, {});
+    VectorXd q, v;
+    varia::testing::morse_chain_state(p, 3, q, v);
+    const VectorXd momentum = p.mass * v;
+    const VectorXd a = varia::testing::run(termwise, q, momentum, 0.1, 5);
+    const VectorXd b = varia::testing::run(one_model, q, momentum, 0.1, 5);
+    CAPTURE(static_cast<int>(form));
+    CHECK((a - b).lpNorm<Eigen::Infinity>() <= 1e-12);
+    CHECK((a.head(n) - q).norm() > 0.05);  // the chain moved
+  }
+}

@@ -1,7 +1,7 @@
 // sdk::AutodiffLagrangian at every size: the stack path (m + n <= 18) and the chunked path above
 // it give L, the gradient and the Hessian of the hand-written formulas of the planar Morse chain
-// (morse_chain.hpp), through every evaluate() path, and its shooting path at jets is refused above
-// the stack size with a message.
+// (morse_chain.hpp), through every evaluate() path, and at jets (the shooting construction's
+// gradient_jet) above the stack size the sum of its bonds' below it.
 #include <doctest/doctest.h>
 
 #include <Eigen/Core>
@@ -103,20 +103,6 @@ TEST_CASE("every evaluate() path of the chunked dense adapter gives the same num
   REQUIRE(model.evaluate(q.data(), v.data(), nullptr, nullptr, hessian_alone.data()) == nullptr);
   CHECK(hessian_alone == all.hessian);
   CHECK(all.hessian == all.hessian.transpose());
-}
-
-TEST_CASE("above the stack size a dense autodiff Lagrangian refuses jet inputs with a message, not a crash") {
-  MorseChainParameters p;
-  p.particles = 5;
-  DenseMorseChain model(p);
-  std::vector<varia::Jet2> q(10, varia::Jet2(1.0)), v(10, varia::Jet2(0.0)), gradient(20);
-  const varia::Status status = model.gradient_jet(q.data(), v.data(), nullptr, gradient.data());
-  REQUIRE(status != nullptr);
-  CHECK(std::string(status) == "an autodiff Lagrangian evaluates at jets with at most 18 position and velocity "
-                               "numbers together");
-  p.particles = 4;
-  DenseMorseChain small(p);
-  CHECK(small.gradient_jet(q.data(), v.data(), nullptr, gradient.data()) == nullptr);
 }
 
 namespace {
@@ -262,4 +248,54 @@ TEST_CASE("hessian_jet at jets of 1 to 6 variables (forward over forward mode wi
     CHECK(hessian[i].constant());
     CHECK(hessian[i].value == doctest::Approx(expected[i]).epsilon(1e-15));
   }
+}
+
+TEST_CASE("above the stack size a dense autodiff Lagrangian evaluates at jets (over its workspace's dual numbers): "
+          "a Morse chain of 5 particles (20 numbers) gives the sum of its 4 bonds' gradient jets, each a 2-particle "
+          "chain of 8 numbers on the stack path, and of the kinetic term's") {
+  MorseChainParameters p;
+  p.particles = 5;
+  p.mass = 1.5;
+  DenseMorseChain chain(p);
+  MorseChainParameters pair = p;
+  pair.particles = 2;
+  pair.mass = 0.0;
+  DenseMorseChain bond(pair);
+  const int n = 2 * p.particles, N = 5;
+  VectorXd q0, v0;
+  varia::testing::morse_chain_state(p, 2, q0, v0);
+  const std::vector<varia::Jet2> wiggle = jet_inputs(2 * n, N);  // nonlinear in the N jet variables
+  std::vector<varia::Jet2> q(n), v(n), gradient(2 * n);
+  for (int i = 0; i < n; ++i) {
+    q[i] = 0.1 * (wiggle[i] - wiggle[i].value) + q0(i);
+    v[i] = 0.1 * (wiggle[n + i] - wiggle[n + i].value) + v0(i);
+  }
+  varia::Jet2 value;
+  REQUIRE(chain.evaluates_at_jets());
+  REQUIRE(chain.gradient_jet(q.data(), v.data(), &value, gradient.data()) == nullptr);
+
+  varia::Jet2 expected_value;
+  std::vector<varia::Jet2> expected(2 * n, varia::Jet2(0.0));
+  for (int i = 0; i < n; ++i) {
+    expected_value += 0.5 * p.mass * v[i] * v[i];
+    expected[n + i] = p.mass * v[i];
+  }
+  for (int b = 0; b + 1 < p.particles; ++b) {
+    varia::Jet2 bond_value;
+    std::vector<varia::Jet2> bond_gradient(8);
+    REQUIRE(bond.gradient_jet(q.data() + 2 * b, v.data() + 2 * b, &bond_value, bond_gradient.data()) == nullptr);
+    expected_value += bond_value;
+    for (int i = 0; i < 4; ++i) expected[2 * b + i] += bond_gradient[i];
+  }
+  double worst = jet_distance(value, expected_value, N);
+  for (int i = 0; i < 2 * n; ++i) worst = std::max(worst, jet_distance(gradient[i], expected[i], N));
+  CHECK(worst < 1e-13);
+  // A wrong derivative is seen: the chain of another range differs by far more.
+  MorseChainParameters other = p;
+  other.range = 1.01;
+  DenseMorseChain wrong(other);
+  REQUIRE(wrong.gradient_jet(q.data(), v.data(), &value, gradient.data()) == nullptr);
+  double far = 0.0;
+  for (int i = 0; i < n; ++i) far = std::max(far, jet_distance(gradient[i], expected[i], N));
+  CHECK(far > 1e-4);
 }

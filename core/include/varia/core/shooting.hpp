@@ -55,7 +55,8 @@
 // quadratures there.
 //
 // Sensitivities in passes: a jet holds at most kMaxJetVariables = 12 variables, or fewer where the
-// field's derivatives at jets take fewer (MechanicalField::jet_variables). Where 2n exceeds that,
+// field's derivatives at jets take fewer (MechanicalField::jet_variables). Where 2n exceeds that
+// (on R^n or on a Lie group),
 // the state is propagated in passes over a few numbers of x each (plan_passes): first derivatives
 // over blocks of x, and of the second derivatives only Phi's columns in w0, the Newton Jacobian's,
 // over pairs of blocks. Every pass has the same values; together they give the one-pass derivatives.
@@ -65,10 +66,10 @@
 // plugin runs it whole with its model inlined (kernel::ExplicitShot), where it takes the plan (the
 // SDK's models: n <= 3); the same numbers as the propagation through the method's plugin.
 //
-// Restrictions: a Lie group of dimension n <= 6 (one pass of jets of 2n <= 12 variables: SE(3));
-// R^n of any dimension. The lagrangian form with a configuration-dependent mass matrix needs L's
-// Hessian at jets of at least 2 variables (the SDK gives 6); the hamiltonian and type-2 forms take
-// any regular Lagrangian (mechanical_field.hpp).
+// Restrictions: none on the dimension (R^n or a Lie group). The lagrangian form with a
+// configuration-dependent mass matrix needs L's Hessian at jets of at least 2 variables (the SDK
+// gives 6, for models of at most 18 position and velocity numbers); the hamiltonian and type-2
+// forms take any regular Lagrangian (mechanical_field.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -99,9 +100,11 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
  public:
   // The method's stage solves use options too. Throws std::invalid_argument for an unsupported
   // manifold, Lagrangian or quadrature, or forces with the type_2 form or an end-derivative rule.
+  // jet_capacity: the most variables of a pass's jets (at most kMaxJetVariables; fewer: more
+  // passes of smaller jets, the same derivatives).
   ShootingDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian, Quadrature& quadrature,
                              OneStepMethod& method, ShootingForm form, SolverOptions options,
-                             std::vector<Force*> forces = {});
+                             std::vector<Force*> forces = {}, int jet_capacity = kMaxJetVariables);
 
   // L_d(q0, q1), D1 L_d, D2 L_d (any output may be null): the boundary-value problem
   // q^n(q0, w0) = q1 solved for w0 by Newton's method. In the type_2 form, L_d is the Legendre

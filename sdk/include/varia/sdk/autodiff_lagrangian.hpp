@@ -17,8 +17,8 @@
 // scalars. A large system whose L is a sum of terms over few numbers each is better written as a
 // TermwiseLagrangian (termwise_lagrangian.hpp): linear cost and a sparse Hessian. The same model,
 // evaluated at dual numbers over second-order jets (kJetDirections derivative directions at a
-// time), gives gradient_jet, for up to kStackVariables numbers (the shooting construction's jets
-// hold fewer variables than that). Forward mode over forward mode at jet values (jet_tangent.hpp)
+// time), gives gradient_jet at any size (sizes read at run time: over inputs kept in a workspace
+// sized once). Forward mode over forward mode at jet values (jet_tangent.hpp)
 // gives hessian_jet at jets of up to 6 variables, which the shooting construction's lagrangian
 // form needs for a configuration-dependent mass matrix (it propagates in passes of at most that
 // many variables: any dimension up to kStackVariables / 2). The same first-order pass, inlined into
@@ -71,6 +71,7 @@ class AutodiffLagrangian : public Lagrangian {
       chunk_q_.resize(m_), chunk_v_.resize(n_);
       chunk2_q_.resize(m_), chunk2_v_.resize(n_);
     }
+    if (!kFixed) jet_q_.resize(m_), jet_v_.resize(n_);
   }
   int position_size() const noexcept final { return m_; }
   int velocity_size() const noexcept final { return n_; }
@@ -156,17 +157,19 @@ class AutodiffLagrangian : public Lagrangian {
     return true;
   }
 
-  // At jets the model runs at dual numbers on the stack: up to kStackVariables numbers (q, v). Above
-  // that the shooting construction refuses the Lagrangian when it is built (validate, exit 2).
-  bool evaluates_at_jets() const noexcept final { return m_ + n_ <= kStackVariables; }
+  // At jets the model runs at dual numbers over jets, kJetDirections numbers of (q, v) at a time:
+  // on the stack for sizes given at compile time, else over the workspace's inputs (any size).
+  bool evaluates_at_jets() const noexcept final { return true; }
   Status gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient) noexcept final {
     return guarded(error_, [&] {
-      if (m_ + n_ > kStackVariables)
-        throw std::length_error("an autodiff Lagrangian evaluates at jets with at most " +
-                                 std::to_string(kStackVariables) + " position and velocity numbers together");
-      if constexpr (kFixedJetVariables > 0)
-        if (jet_variables(q, v) == kFixedJetVariables) return at_fixed_jets<kFixedJetVariables>(q, v, value, gradient);
-      at_jets(q, v, value, gradient);
+      if constexpr (kFixed) {
+        if constexpr (kFixedJetVariables > 0)
+          if (jet_variables(q, v) == kFixedJetVariables) return at_fixed_jets<kFixedJetVariables>(q, v, value, gradient);
+        at_jets(q, v, value, gradient);
+      } else {
+        for (int first = 0; first < m_ + n_; first += kJetDirections)
+          jet_first_order(jet_q_, jet_v_, q, v, first, first == 0 ? value : nullptr, gradient);
+      }
     });
   }
   int hessian_jet_variables() const noexcept final { return m_ + n_ <= kStackVariables ? kMaxHessianJetVariables : 0; }
@@ -344,26 +347,22 @@ class AutodiffLagrangian : public Lagrangian {
     if (value != nullptr) fixed_value.to_jet2(*value);
     for (int i = 0; i < m_ + n_; ++i) outputs[i].to_jet2(gradient[i]);
   }
-  // At jets J: one pass of forward mode over every number of (q, v) up to two of them, else one
-  // per block of kJetDirections.
+  // At jets J (sizes given at compile time): one pass of forward mode over every number of (q, v)
+  // up to two of them, else one per block of kJetDirections, over dual numbers on the stack.
   template <class J>
   void at_jets(const J* q, const J* v, J* value, J* gradient) const {
-    if constexpr (kFixed && Positions + Velocities <= 2) {
-      jet_first_order<2>(q, v, 0, value, gradient);
-    } else {
-      if (!kFixed && m_ + n_ <= 2) return jet_first_order<2>(q, v, 0, value, gradient);
-      for (int first = 0; first < m_ + n_; first += kJetDirections)
-        jet_first_order<kJetDirections>(q, v, first, first == 0 ? value : nullptr, gradient);
-    }
+    constexpr int K = Positions + Velocities <= 2 ? 2 : kJetDirections;
+    Vec<JetDual<K, J>> qd(m_), vd(n_);
+    for (int first = 0; first < m_ + n_; first += K)
+      jet_first_order(qd, vd, q, v, first, first == 0 ? value : nullptr, gradient);
   }
   // L (if value is not null) and the derivatives in the numbers first .. first + K - 1 of (q, v)
-  // (those that exist) at jet inputs: forward mode over the jets, one derivative direction per
-  // number of the block.
-  template <int K, class J>
-  void jet_first_order(const J* q, const J* v, int first, J* value, J* gradient) const {
-    using JD = JetDual<K, J>;
+  // (those that exist, K the dual numbers' directions) at jet inputs: forward mode over the jets,
+  // one derivative direction per number of the block, over the dual inputs qd, vd.
+  template <class JD, class J>
+  void jet_first_order(Vec<JD>& qd, Vec<JD>& vd, const J* q, const J* v, int first, J* value, J* gradient) const {
+    constexpr int K = JD::DerType::MaxRowsAtCompileTime;
     const int k = m_ + n_, last = std::min(first + K, k);
-    Vec<JD> qd(m_), vd(n_);
     for (int i = 0; i < k; ++i) seed(input(qd, vd, i), at(q, v, m_, i), K, i - first);
     const JD r = model().lagrangian(qd, vd);
     if (value != nullptr) *value = r.value();
@@ -473,8 +472,10 @@ class AutodiffLagrangian : public Lagrangian {
 
   int m_, n_;
   mutable std::optional<bool> constant_mass_form_;
-  // Workspace, sized once: the value's inputs, and above kStackVariables the chunks' dual inputs.
+  // Workspace, sized once: the value's inputs, above kStackVariables the chunks' dual inputs, and
+  // for sizes read at run time the dual inputs over jets.
   Vec<double> q_, v_;
+  Vec<ChunkJetDual> jet_q_, jet_v_;
   Vec<ChunkDual> chunk_q_, chunk_v_;
   Vec<ChunkDual2> chunk2_q_, chunk2_v_;
 };

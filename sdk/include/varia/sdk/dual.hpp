@@ -24,8 +24,9 @@ inline constexpr int kStackVariables = 18;
 // of the model; a Hessian: one pass per pair of chunks).
 inline constexpr int kChunkDirections = 8;
 // First derivatives at jet inputs (Lagrangian::gradient_jet) are taken kJetDirections numbers of
-// (q, v) at a time, one evaluation per block: a dual number over jets then holds 1 + 4 jets, and
-// a Vec of them (18 x 5 x 1.3 kB) stays within Eigen's stack allocation limit (128 kB).
+// (q, v) at a time, one evaluation per block: a dual number over jets then holds 1 + 4 jets. A
+// model of sizes given at compile time (at most 12 numbers) keeps a Vec of them on the stack; one
+// of sizes read at run time keeps them in a workspace sized once (ChunkJetDual), at any size.
 inline constexpr int kJetDirections = 4;
 // L's Hessian at jet inputs (Lagrangian::hessian_jet) is taken kHessianJetDirections by
 // kHessianJetDirections numbers of (q, v) at a time, at jets of up to kMaxHessianJetVariables
@@ -54,13 +55,16 @@ using FixedDual2 = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<K>, K, 1>>;
 // directions.
 template <int K, class J = Jet2>
 using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<J, K, 1>>;
+// The dual number over jets of models whose sizes are read at run time: kJetDirections directions
+// (fewer in the last block), a type of its own whose Vec holds any number of inputs.
+using ChunkJetDual = Eigen::AutoDiffScalar<Bounded<Jet2, kJetDirections>>;
 // The large systems' dual numbers: kChunkDirections directions (fewer in the last chunk).
 using ChunkDual = Eigen::AutoDiffScalar<Bounded<double, kChunkDirections>>;
 using ChunkDual2 = Eigen::AutoDiffScalar<Bounded<ChunkDual, kChunkDirections>>;
 static_assert(kChunkDirections != kStackVariables, "the chunk duals must be types of their own (see Vec)");
 
 // Whether a Vec of T has the stack capacity kStackVariables: every scalar but the value type and
-// the large systems' chunk duals, whose vectors hold any number of inputs.
+// the chunk duals, whose vectors hold any number of inputs.
 template <class T>
 struct OnStack : std::true_type {};
 template <>
@@ -69,6 +73,8 @@ template <>
 struct OnStack<ChunkDual> : std::false_type {};
 template <>
 struct OnStack<ChunkDual2> : std::false_type {};
+template <>
+struct OnStack<ChunkJetDual> : std::false_type {};
 
 // The vectors q and v a model's lagrangian<T>(q, v) takes.
 template <class T>
