@@ -45,6 +45,8 @@ struct FixedRule : Quadrature {
 
 inline FixedRule trapezoid() { return FixedRule({0.0, 1.0}, {0.5, 0.5}, 1); }
 inline FixedRule lobatto3() { return FixedRule({0.0, 0.5, 1.0}, {1.0 / 6, 4.0 / 6, 1.0 / 6}, 3); }
+// The s-point Gauss-Legendre rule on [0, 1] (tests/fixtures.cpp).
+FixedRule gauss_legendre(int s);
 
 // L = v^2/2 - q^2/2 (unit oscillator) or v^2/2 + cos q (unit pendulum) on R^1.
 struct Oscillator : sdk::AutodiffLagrangian<Oscillator, 1, 1> {

@@ -2,7 +2,6 @@
 
 #include <doctest/doctest.h>
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <limits>
@@ -264,25 +263,6 @@ TEST_CASE("galerkin Newton solves to round-off: order-8 runs at 1376 and 2752 st
   CHECK(std::abs(end[0][0] - end[1][0]) < 2e-14);
   CHECK(std::abs(end[0][1] - end[1][1]) < 2e-14);
 }
-
-namespace {
-
-// The s-point Gauss-Legendre rule on [0, 1] (Golub & Welsch: the nodes are the eigenvalues of the
-// Jacobi matrix of the Legendre recurrence, the weights the squared first components of its
-// eigenvectors).
-FixedRule gauss_legendre(int s) {
-  Eigen::MatrixXd jacobi = Eigen::MatrixXd::Zero(s, s);
-  for (int k = 1; k < s; ++k) jacobi(k, k - 1) = jacobi(k - 1, k) = k / std::sqrt(4.0 * k * k - 1.0);
-  const Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> eigen(jacobi);
-  std::vector<double> c(s), b(s);
-  for (int i = 0; i < s; ++i) {
-    c[i] = (1.0 + eigen.eigenvalues()[i]) / 2;
-    b[i] = eigen.eigenvectors()(0, i) * eigen.eigenvectors()(0, i);
-  }
-  return FixedRule(c, b, 2 * s - 1);
-}
-
-}  // namespace
 
 // For a constant mass matrix the step's equations are solved by simplified Newton in the nodes'
 // coordinates (forces only), stopped when the residual its last update leaves is below F's

@@ -16,15 +16,6 @@ using Eigen::Vector3d;
 
 namespace {
 
-FixedRule gauss2() {
-  const double d = std::sqrt(3.0) / 6;
-  return FixedRule({0.5 - d, 0.5 + d}, {0.5, 0.5}, 3);
-}
-FixedRule gauss3() {
-  const double d = std::sqrt(15.0) / 10;
-  return FixedRule({0.5 - d, 0.5, 0.5 + d}, {5.0 / 18, 8.0 / 18, 5.0 / 18}, 5);
-}
-
 // The free body declaring its invariance under the whole of SO(3) (three momentum components),
 // which the reduced form needs.
 struct FreeBody : Top {
@@ -141,9 +132,9 @@ TEST_CASE("lie group galerkin of degree s is of order 2s on SO3 (free body and h
   // Degree 3 (order 6) reaches the reference's accuracy (about 1e-12 at t = 2) from 80 steps on: coarser
   // steps, and no point past it.
   const std::vector<Case> cases{{1, trapezoid(), {50, 100, 200, 400}},
-                                {2, gauss2(), {25, 50, 100, 200}},
+                                {2, gauss_legendre(2), {25, 50, 100, 200}},
                                 {2, lobatto3(), {25, 50, 100, 200}},
-                                {3, gauss3(), {10, 20, 40}}};
+                                {3, gauss_legendre(3), {10, 20, 40}}};
   for (const auto& c : cases)
     for (bool top : {false, true}) {
       Problem p = top ? heavy_top() : free_body();
@@ -160,7 +151,7 @@ TEST_CASE("lie group galerkin of degree s is of order 2s on SO3 (free body and h
 TEST_CASE("lie group galerkin conserves spatial angular momentum and orthogonality at round-off") {
   Rotations group;
   Problem p = free_body();
-  auto rule = gauss2();
+  auto rule = gauss_legendre(2);
   auto galerkin = make(group, p.top, rule, 2);
   const Vector3d pi0 = spatial_momentum(p.start);
   State y = p.start, next;
@@ -190,7 +181,7 @@ TEST_CASE("lie group galerkin: the group's increment keeps R on SO3 over a long 
     bool has_increment() const noexcept override { return false; }
   };
   Problem p = free_body();
-  auto rule = gauss2();
+  auto rule = gauss_legendre(2);
   const Vector3d pi0 = spatial_momentum(p.start);
   const auto run = [&](Manifold& group, double& momentum) {
     auto galerkin = make(group, p.top, rule, 2);
@@ -235,7 +226,7 @@ TEST_CASE("lie group galerkin conserves the heavy top's vertical angular momentu
 TEST_CASE("lie group galerkin: the step solves p0 = -D1 L_d and p1 = D2 L_d, and D1, D2 differentiate L_d") {
   Rotations group;
   Problem p = heavy_top();
-  auto rule = gauss3();
+  auto rule = gauss_legendre(3);
   auto galerkin = make(group, p.top, rule, 3);
   const double h = 0.1;
   State y;
@@ -267,7 +258,7 @@ TEST_CASE("lie group galerkin: the step solves p0 = -D1 L_d and p1 = D2 L_d, and
 TEST_CASE("lie group galerkin Newton converges quadratically from a cold start") {
   Rotations group;
   Problem p = heavy_top();
-  auto rule = gauss3();
+  auto rule = gauss_legendre(3);
   auto galerkin = make(group, p.top, rule, 3);
   State y;
   galerkin->step(p.start.data(), p.start.data() + 9, 0.3, y.data(), y.data() + 9);
@@ -286,7 +277,7 @@ TEST_CASE("reduced (discrete Euler-Poincare) form agrees with the unreduced one 
   Rotations group;
   FreeBody body;
   Problem p = free_body();
-  auto rule = gauss2();
+  auto rule = gauss_legendre(2);
   auto full = make(group, body, rule, 2);
   auto reduced = make(group, body, rule, 2, true);
   const State a = integrate(*full, p.start, 0.05, 400), b = integrate(*reduced, p.start, 0.05, 400);
@@ -306,7 +297,7 @@ TEST_CASE("reduced lie group galerkin with a constant mass matrix: no Lagrangian
   Rotations group;
   FreeBody body;
   Problem p = free_body();
-  auto rule = gauss2();
+  auto rule = gauss_legendre(2);
   auto galerkin = make(group, body, rule, 2, true);
   State y = p.start, next;
   galerkin->step(y.data(), y.data() + 9, 0.05, next.data(), next.data() + 9);  // a cold start
@@ -330,7 +321,7 @@ TEST_CASE("reduced lie group galerkin with a constant mass matrix: no Lagrangian
 TEST_CASE("reduced form is refused for a Lagrangian not invariant under the whole group") {
   Rotations group;
   Problem p = heavy_top();
-  auto rule = gauss2();
+  auto rule = gauss_legendre(2);
   CHECK_THROWS_WITH_AS(make(group, p.top, rule, 2, true), doctest::Contains("invariant under the whole group"),
                        std::invalid_argument);
 }

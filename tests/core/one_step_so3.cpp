@@ -6,7 +6,7 @@
 #include <filesystem>
 #include <memory>
 
-#include "core/fixtures.hpp"
+#include "core/shooting_fixtures.hpp"
 #include "core/so3_reference.hpp"
 #include "varia/core/lie_verlet.hpp"
 #include "varia/core/one_step_map.hpp"
@@ -18,9 +18,6 @@ using namespace varia;
 using namespace varia::testing;
 
 namespace {
-
-sdk::RungeKutta explicit_midpoint() { return {sdk::explicit_midpoint(), 2, false}; }
-sdk::RungeKutta implicit_midpoint() { return {sdk::collocation_tableau({0.5}), 2, true}; }
 
 // The largest ||I - R^T R|| and |E - E0| over `steps` steps of h from p.start.
 struct Drift {

@@ -25,6 +25,8 @@
 
 namespace {
 
+using varia::test::rn;
+
 using Eigen::VectorXd;
 using Json = nlohmann::json;
 using varia::Effect;
@@ -32,8 +34,6 @@ using varia::Effect;
 constexpr int kDim = 3;
 const double kMasses[] = {1.0, 2.0, 3.0};
 const double kMasses5[] = {1.0, 2.0, 1.0, 3.0, 1.0};
-
-Json rn(int n) { return {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}}; }
 
 std::shared_ptr<Effect> make_effect(const std::string& type, const Json& parameters) {
   auto effect = varia::test::load_plugin("effect", type).create<Effect>(parameters, rn(3 * kDim));
@@ -210,9 +210,9 @@ VectorXd shooting(varia::ShootingForm form, const State& start, double h, double
 
 // The inner effect with the derivatives of its gradient at jets 1.5 times too large (the values
 // and everything at doubles right): what the effect suite's Taylor tests at jets must refuse.
-class LyingJets final : public Effect {
+class LyingJetEffect final : public Effect {
  public:
-  explicit LyingJets(std::shared_ptr<Effect> inner) : inner_(std::move(inner)) {}
+  explicit LyingJetEffect(std::shared_ptr<Effect> inner) : inner_(std::move(inner)) {}
   varia::Status bind(int space_dim, int particles, const double* masses) noexcept override {
     return inner_->bind(space_dim, particles, masses);
   }
@@ -278,7 +278,7 @@ TEST_CASE("the composite elastic pendulum under shooting (rk4 + Simpson, the eff
 
 TEST_CASE("the effect suite refuses an effect whose gradient at jets has wrong derivatives, and shooting refuses a "
           "composite with an effect that gives no gradient at jets") {
-  LyingJets lying(make_effect("central", {{"particle", 1}}));
+  LyingJetEffect lying(make_effect("central", {{"particle", 1}}));
   std::mt19937 engine(7);
   const auto failures = varia::sdk::conformance::check_effect(lying, 3 * kDim, engine);
   REQUIRE_FALSE(failures.empty());

@@ -18,10 +18,10 @@
 
 namespace {
 
+using varia::test::rn;
+
 using Eigen::VectorXd;
 using Json = nlohmann::json;
-
-Json rn(int n) { return {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}}; }
 
 std::shared_ptr<varia::CompositeLagrangian> gravitating(int space_dim, const std::vector<double>& masses,
                                                         const Json& parameters) {

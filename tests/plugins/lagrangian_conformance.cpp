@@ -20,12 +20,13 @@
 
 namespace {
 
+using varia::test::rn;
+
 using Eigen::VectorXd;
 using varia::Lagrangian;
 using Json = nlohmann::json;
 
 // The context of a plugin on Rn with dim n.
-Json rn(int n) { return {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}}; }
 const Json kSO3 = {{"manifold", "SO3"}, {"point_size", 9}, {"dim", 3}};
 
 std::shared_ptr<Lagrangian> make(const std::string& type, const Json& parameters,

@@ -17,6 +17,9 @@ namespace varia::test {
 
 using sdk::conformance::LoadedPlugin;
 
+// The manifold description a plugin is created with on R^n.
+inline nlohmann::json rn(int n) { return {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}}; }
+
 inline std::filesystem::path plugin_directory() {
   return std::filesystem::path(VARIA_BUILD_DIR) / "lib" / "varia" / "plugins";
 }

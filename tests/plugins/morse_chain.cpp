@@ -19,12 +19,12 @@
 
 namespace {
 
+using varia::test::rn;
+
 using Eigen::MatrixXd;
 using Eigen::VectorXd;
 using Json = nlohmann::json;
 using varia::testing::MorseChainParameters;
-
-Json rn(int n) { return {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}}; }
 
 std::shared_ptr<varia::Lagrangian> plugin_chain(const MorseChainParameters& p) {
   return varia::test::load_plugin("lagrangian", "morse_chain")

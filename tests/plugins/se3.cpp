@@ -79,8 +79,6 @@ struct SpringBody {
   }
 };
 
-}  // namespace
-
 // The error at T = 1 after `steps` steps of `map`: |log(q_ref^{-1} q)| and the momenta's largest
 // difference, against Lie group Galerkin s = 4 (order 8) at h = 1/80, converged to ~1e-16.
 struct ConvergedReference {
@@ -115,6 +113,8 @@ struct ConvergedReference {
     return slope;
   }
 };
+
+}  // namespace
 
 TEST_CASE("SE3 spring-suspended body: Lie group Galerkin s = 1, 2, 3 is of order 2, 4, 6 against a converged reference") {
   SpringBody system;
