@@ -318,10 +318,9 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
 // gradient is not finite, the loop here calls the plugin once a step.
 // N is n, or Dynamic. For a fixed N the state (q, h v, dL/dq) is held in local fixed-size vectors
 // across the steps, and the plugin reads q and writes [dL/dq, dL/dv] in one small local array
-// (`io`): a step is a few registers' arithmetic and one plugin call. (With the plugin's input and
-// output in the class's heap vectors the same loop took 40 ns a step instead of 29 on the
-// benchmark machine: bench/README.md.) The dynamic form works on the caller's arrays and the
-// class's workspace; neither allocates.
+// (`io`): a step is a few registers' arithmetic and one plugin call, with no load from the class's
+// heap vectors (bench/README.md, "Measured design choices"). The dynamic form works on the
+// caller's arrays and the class's workspace; neither allocates.
 template <int N>
 void GalerkinDiscreteLagrangian::explicit_advance(double* q, double* p, double h, long steps) {
   using Vector = Eigen::Matrix<double, N, 1>;
@@ -654,8 +653,8 @@ void GalerkinDiscreteLagrangian::prepare_sparse(int first_unknown, int first_equ
 // Offsets from q0, numbers of size h |v|: q0 + offset rounds to eps |q0|, where forming the
 // positions themselves would add eps |q0| at every step (docs/hard-cases.md, Kepler).
 // The sum over points runs in four accumulators (points i mod 4): it is on the chain from one
-// pass's forces to the next pass's, and one accumulator made it a chain of C dependent additions
-// (the s = 4 Gauss step of the pendulum took 155 ns instead of 151; issue #19).
+// pass's forces to the next pass's, and one accumulator would make it a chain of C dependent
+// additions.
 template <int N, int Rows, int C>
 [[gnu::always_inline]] inline void GalerkinDiscreteLagrangian::offsets_from_forces(const Eigen::MatrixXd& map, double h,
                                                                                   const double* __restrict accelerations,
@@ -927,8 +926,8 @@ void GalerkinDiscreteLagrangian::take_step(const double* q0, const double* p0, d
 // residuals are at hand). Both sums are compensated across steps (compensated.hpp) when a step
 // continues from the last one's output.
 // At N = n and R nodes of the node iteration where both are small (for_shape), in
-// loops of a fixed length: at n = 1 the same step through dynamic-size Eigen expressions took
-// 340 instructions of bookkeeping besides the solve.
+// loops of a fixed length: at small n, dynamic-size Eigen expressions spend more on bookkeeping
+// than on the solve.
 template <int N, int R>
 void GalerkinDiscreteLagrangian::step_at(const double* q0, const double* p0, double h, double* q1, double* p1) {
   using Vector = Eigen::Matrix<double, N, 1>;

@@ -398,8 +398,8 @@ void LieGroupGalerkinDiscreteLagrangian::newton(const double* q0, const double* 
 // O(h^(2s+1)) of the next step's when the steps before followed each other too), else through the
 // last step's (its curve continued, O(h^(s+1))), at the times 1 + d_nu, mapped into this step's
 // chart through the group. With the start that much closer, simplified Newton's first update,
-// whose contraction is O(that distance), mostly leaves a residual at round-off: on the rigid body
-// (s = 2, h = 0.05) the step's evaluations fell from 4 to 3 (issue #19).
+// whose contraction is O(that distance), mostly leaves a residual at round-off, and the step takes
+// one evaluation fewer (bench/README.md, "Measured design choices").
 // Otherwise xi(t) = t v0 with v0 from the inverse Legendre transform of p0.
 // The last step's control points in this step's chart (earlier_, the next step's history): xi^0
 // is g0_last = g0 exp(-xi^s_last), the others through the group.

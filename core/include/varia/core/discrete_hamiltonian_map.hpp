@@ -61,8 +61,7 @@ class DiscreteHamiltonianMap {
   }
   // The loop of take_steps() by `step` (take_step's arguments): a map that overrides take_steps
   // to step by a non-virtual function passes it here. The steps go back and forth between (q, p)
-  // and (q1, p1), the state copied once at the end if it is in (q1, p1): a copy a step was two
-  // calls of memmove (issue #19).
+  // and (q1, p1), the state copied once at the end if it is in (q1, p1), not once a step.
   template <class Step>
   void repeat_steps(Step&& step, double* q, double* p, double t0, double h, long steps, double* q1, double* p1) {
     double *from_q = q, *from_p = p, *to_q = q1, *to_p = p1;

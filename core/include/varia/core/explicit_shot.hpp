@@ -27,9 +27,8 @@
 namespace varia {
 
 // out = start + terms(): a small T (a double, a FixedJet) summed in a local, which stays in
-// registers (summed in place, every term stores and reloads it: the pendulum's SVIRK4 shot, timed
-// alone, took 13% longer); a Jet2 (1.3 kB) in place, where a local is one more copy (the
-// hamiltonian form's SVIRK4 steps, which propagate Jet2 through the method, took 2% longer).
+// registers (summed in place, every term would store and reload it); a Jet2 (1.3 kB) in place,
+// where a local is one more copy (bench/README.md, "Measured design choices").
 template <class T, class Terms>
 void linear_combination(T& out, const T& start, Terms&& terms) {
   if constexpr (std::is_same_v<T, Jet2>) {

@@ -25,7 +25,7 @@
 // derivative, then reconstructs g1 = g0 f and p1 = dexp_{-xi^s}^{-T} sigma = Ad*_f p0.
 // These are the step's equations above with tau = 0 and L(g0 exp(xi), Omega) = L(g0, Omega), so
 // the map takes the reduced form's evaluation for every such Lagrangian: the position jets would
-// add exact zeros, and took a third of a step (issue #19). `reduced` asks for it and throws where
+// add exact zeros at a large part of a step's cost. `reduced` asks for it and throws where
 // it does not apply. Its Jacobian needs only d2l/dOmega2, which is M for a Lagrangian declaring a
 // constant mass matrix (L = 1/2 v^T M v - V(q)): its nodes then evaluate L's gradient only.
 #pragma once

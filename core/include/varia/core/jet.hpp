@@ -101,10 +101,10 @@ J binary(const J& a, const J& b, double f, const Partials& d) {
 // sizes are constants, so that it is a few fixed-size loops the compiler unrolls (the outer
 // products as loops: as Eigen expressions GCC left their assignment out of line, a quarter of a
 // shot), and where the partials are constants (a sum's 1, 1, 0, 0, 0) the terms they zero go. A
-// constant operand (FixedJet::is_constant) is skipped as Jet2's is. The terms are those of the loops above, summed in the same order, so that both give the
-// same numbers; the zero ones are skipped as there (0 * an infinite gradient would make NaN). A SVIRK4
-// step of the pendulum, whose model the SDK evaluates at dual numbers over FixedJet<2>: 4.57 ->
-// 3.80 us; the loops above, inlined instead, made it slower (4.68 us).
+// constant operand (FixedJet::is_constant) is skipped as Jet2's is. The terms are those of the
+// loops above, summed in the same order, so that both give the same numbers; the zero ones are
+// skipped as there (0 * an infinite gradient would make NaN). The loops above, inlined instead,
+// are slower (bench/README.md, "Measured design choices").
 template <int N, int C>
 [[gnu::always_inline]] inline FixedJet<N, C> unary(const FixedJet<N, C>& a, double f, double d1, double d2) {
   if (a.constant() || (d1 == 0.0 && d2 == 0.0)) return FixedJet<N, C>(f);
@@ -289,9 +289,9 @@ inline void add_scaled(Jet2& r, double c, const Jet2& x) {
 // A jet over exactly N variables; a constant is one whose derivatives are zero.
 // Default-constructed it is uninitialized, as a double is: Eigen constructs every element of a
 // fixed-capacity vector (the SDK's sdk::Vec of dual numbers over FixedJet holds 18), and zeroing
-// them took a quarter of a SVIRK4 step (issue #19: 5.15 -> 3.98 us a step of the pendulum). Every
-// use assigns first (valgrind's memcheck finds no read of one on the shooting and Lie group
-// scenes); FixedJet(0.0) is the zero jet.
+// them would cost a large part of a shooting step (bench/README.md). Every use assigns first
+// (valgrind's memcheck finds no read of one on the shooting and Lie group scenes); FixedJet(0.0)
+// is the zero jet.
 template <int N, int C>
 struct FixedJet : JetArithmetic<FixedJet<N, C>> {
   static_assert(C >= 1 && C <= N);

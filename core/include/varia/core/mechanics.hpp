@@ -28,7 +28,7 @@ class LagrangianEvaluator {
   void gradient(const double* q, const double* v, double* gradient) { evaluate_gradient(q, v, nullptr, gradient); }
   // The gradients at `count` points z_i = (q, v) (m + n numbers each) in one plugin call
   // (Lagrangian::gradients), each counted and checked as gradient() does. Inline: the node
-  // iteration calls it at every pass (issue #19).
+  // iteration calls it at every pass.
   void gradients(int count, const double* points, double* gradients) {
     check(lagrangian_, lagrangian_.gradients(count, points, gradients), "Lagrangian gradients");
     counters_.gradient += count;

@@ -313,7 +313,7 @@ inline Jet2& jet6(Jet2& jet, double value) {
 // left-trivialized velocity dexp_{-xi}(xi_dot) as 3 jets in (xi, xi_dot). Either output may be
 // null; without point_second (velocity_second) that output's Hessians are left unset.
 // exp(xi) and dexp_{-xi} come with their derivatives in xi from quadratic_in_hat (in doubles; at
-// 3-variable jets they took most of a Lie group Galerkin step), and the rest is assembled from
+// 3-variable jets they would dominate a Lie group Galerkin step), and the rest is assembled from
 // them with double 3 x 3 products:
 //  - eta enters through exp(eta) = I + hat(eta) + hat(eta)^2/2 + O(|eta|^3), so with E = exp(xi),
 //    B = R0, H_k = hat(e_k): dR/deta_k = B H_k E, d2R/deta_k deta_l = B (H_k H_l + H_l H_k)/2 E,

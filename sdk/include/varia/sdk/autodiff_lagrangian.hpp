@@ -334,7 +334,7 @@ class AutodiffLagrangian : public Lagrangian {
   // numbers each, every loop of the chain rule of a fixed length), converted from and to Jet2.
   // A shooting pass's jets have up to twice the manifold's dimension in variables (shooting.hpp).
   // The model reads only the first m + n inputs, which are set; GCC cannot see that, and warns of
-  // the others (uninitialized FixedJet's, jet.hpp). Filling them took a sixth of the evaluation.
+  // the others (uninitialized FixedJet's, jet.hpp). Filling them would cost a large part of the evaluation.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"

@@ -141,9 +141,8 @@ inline void require_converged(const SolveReport& report, const char* equations) 
 
 // |x|_inf by a plain loop, NaN if an entry is. The systems store F and the update entry by entry
 // just before the solver measures them, and a vectorized load of two entries waits for both
-// stores (the store cannot be forwarded): with Eigen's lpNorm the s = 2 Gauss step of the
-// pendulum took 4% longer (issue #19). Branch-free (with a branch per new maximum it took 13%
-// longer than with lpNorm): the sum carries a NaN.
+// stores (the store cannot be forwarded), which Eigen's lpNorm does. Branch-free (a branch per
+// new maximum is slower still): the sum carries a NaN. Measured: bench/README.md.
 inline double max_norm(const Eigen::VectorXd& x) {
   double largest = 0.0, sum = 0.0;
   for (Eigen::Index k = 0; k < x.size(); ++k) {
@@ -228,9 +227,8 @@ class NewtonSolver {
  private:
   // Simplified Newton's loop (the rule above): the first update cannot end the solve (no
   // contraction is measured yet); |update| enters only where the residual stopped decreasing.
-  // Its own loop, without the exact Jacobian's tests, inlined into solve(): at the s = 2 Gauss step
-  // of the pendulum a step took 5% longer with both in one loop, and about 10% longer with this
-  // loop out of line (issue #19).
+  // Its own loop, without the exact Jacobian's tests, inlined into solve(): one loop for both, or
+  // this one out of line, is slower (bench/README.md, "Measured design choices").
   template <class System>
   [[gnu::always_inline]] inline SolveReport solve_simplified(System& system) {
     double left = kBrouwer;
