@@ -30,20 +30,6 @@ json oscillator_scene() {
     "initial": {"q": [1.0], "p": [0.0]}, "step": 0.1, "t_end": 2, "observe": ["energy"]})");
 }
 
-// Runs `shell` (a /bin/sh command line, run from the source directory) with stdout and stderr
-// captured, unless the command redirects them itself.
-Outcome run_shell(const std::string& shell) {
-  TempDir dir;
-  const std::string command = "cd '" + kSourceDir.string() + "' && { " + shell + " ; } > '" +
-                              (dir / "stdout").string() + "' 2> '" + (dir / "stderr").string() + "'";
-  const int status = std::system(command.c_str());
-  return Outcome{WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(dir / "stdout"), read_file(dir / "stderr")};
-}
-
-std::string varia() { return "'" + varia_program().string() + "'"; }
-
-std::string quoted(const fs::path& file) { return "'" + file.string() + "'"; }
-
 // Every line ends with a newline and has as many cells as the header.
 void check_whole_rows(const std::string& csv) {
   REQUIRE_FALSE(csv.empty());
