@@ -235,8 +235,10 @@ int run_command_line(int argc, char** argv, const std::function<bool(const std::
   app.set_version_flag("--version", VARIA_VERSION);
   app.require_subcommand(1);
   app.footer(
-      "Exit codes: 0 success, 2 bad input, 3 plugin fault, 4 numerical failure.\n"
-      "Plugins are searched in the bundled directory, then --plugin-path, then VARIA_PLUGIN_PATH.\n"
+      "Exit codes: 0 success, 1 (verify) a predicted property does not hold, 2 bad input, 3 plugin fault,\n"
+      "4 numerical failure, 128 + N interrupted by signal N (130 SIGINT, 143 SIGTERM, 129 SIGHUP).\n"
+      "Plugins are searched in the bundled directory, then --plugin-path, then VARIA_PLUGIN_PATH;\n"
+      "directories a group may write are trusted under those named in VARIA_TRUSTED_PLUGIN_DIRS.\n"
       "Example:\n  varia run scenes/default.json --out traj.csv --summary run.json");
   Options options;
   Command chosen;

@@ -27,7 +27,7 @@ Noted noted[kMaxPlugins];
 volatile std::sig_atomic_t noted_count = 0;
 
 volatile std::sig_atomic_t command_running = 0;
-CsvWriter* volatile watched = nullptr;
+CrashSafeOutput* volatile watched = nullptr;
 
 alignas(16) char alternate_stack[1 << 16];  // a stack overflow still runs the handler
 
@@ -100,9 +100,9 @@ const void* faulting_instruction(const void* context) {
 #endif
 }
 
-// A plugin ended the process: its buffered whole rows go out, the line names it, exit code 3.
+// A plugin ended the process: the trajectory is left whole, the line names it, exit code 3.
 [[noreturn]] void end_for_plugin(Line& line) {
-  if (CsvWriter* writer = watched) writer->write_whole_rows();
+  if (CrashSafeOutput* output = watched) output->end_on_crash();
   line.add(kAftermath).write();
   ::_exit(kExitPlugin);
 }
@@ -159,6 +159,6 @@ void note_plugin_file(const std::filesystem::path& file) {
 CommandInFlight::CommandInFlight() { command_running = 1; }
 CommandInFlight::~CommandInFlight() { command_running = 0; }
 
-void watch_trajectory(CsvWriter* writer) { watched = writer; }
+void watch_trajectory(CrashSafeOutput* output) { watched = output; }
 
 }  // namespace varia::host

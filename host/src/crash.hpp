@@ -4,12 +4,12 @@
 //
 // - A fatal signal (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT; handled on an alternate stack, so a
 //   stack overflow too) whose faulting instruction, or a frame of whose stack, lies in a plugin
-//   file: one line names the file, the trajectory's buffered whole rows are written, and varia
+//   file: one line names the file, the trajectory is left whole (watch_trajectory), and varia
 //   ends with exit code 3 (spec: plugin fault). With no plugin code on the stack (a fault of varia
 //   itself) the line says so and the signal's default action ends varia (e.g. 139, a core dump).
 // - exit() or quick_exit() called while a command runs (varia itself never calls them; its
-//   commands return to main): one line names the plugin on the stack, the trajectory's buffered
-//   whole rows are written, and varia ends with exit code 3, whatever status the plugin asked for.
+//   commands return to main): one line names the plugin on the stack, the trajectory is left
+//   whole, and varia ends with exit code 3, whatever status the plugin asked for.
 //
 // Nothing here costs anything per call into a plugin: the plugin is found from the program
 // counter and the stack (dladdr) when the process ends, among the files the registry noted.
@@ -19,7 +19,7 @@
 
 namespace varia::host {
 
-class CsvWriter;
+class CrashSafeOutput;
 
 void install_crash_handlers();
 
@@ -35,8 +35,9 @@ class CommandInFlight {
   CommandInFlight& operator=(const CommandInFlight&) = delete;
 };
 
-// The trajectory being written (nullptr: none), whose buffered whole rows the handlers write out
-// before the process ends (CsvWriter::write_whole_rows).
-void watch_trajectory(CsvWriter* writer);
+// The trajectory being written (nullptr: none), which the handlers leave whole before the process
+// ends (CrashSafeOutput::end_on_crash: the CSV writes its buffered whole rows, the HDF5 file keeps
+// its flushed blocks).
+void watch_trajectory(CrashSafeOutput* output);
 
 }  // namespace varia::host

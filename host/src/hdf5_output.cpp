@@ -1,11 +1,17 @@
 #include "hdf5_output.hpp"
 
+#include <fcntl.h>
 #include <hdf5.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include <fmt/format.h>
 
 #include <cctype>
+#include <cerrno>
+#include <cstring>
 
+#include "crash.hpp"
 #include "errors.hpp"
 
 namespace varia::host {
@@ -14,33 +20,112 @@ namespace {
 
 constexpr hsize_t kBlockRows = 1024;  // rows per append, and the datasets' chunk length
 
+// The cause HDF5 gives for the failure it just reported: its innermost error's description, or
+// where that quotes the system's message ("error message = '...'"), that message. Read before any
+// other call into the library, which clears its error stack.
+std::string hdf5_cause() {
+  std::string description;
+  const auto innermost = [](unsigned n, const H5E_error2_t* error, void* data) -> herr_t {
+    if (n == 0 && error->desc != nullptr) *static_cast<std::string*>(data) = error->desc;
+    return 0;
+  };
+  H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, innermost, &description);
+  constexpr std::string_view kQuote = "error message = '";
+  if (const auto at = description.find(kQuote); at != std::string::npos) {
+    const auto from = at + kQuote.size();
+    return description.substr(from, description.find('\'', from) - from);
+  }
+  return description.empty() ? "the HDF5 library gives no reason" : description;
+}
+
 }  // namespace
 
-Hdf5Writer::Hdf5Writer(const std::filesystem::path& file, const std::string& scene_text) : name_(file.string()) {
+Hdf5Writer::Lock::Lock(const std::filesystem::path& file) {
+  fd_ = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (fd_ < 0) {
+    if (errno == ENOENT) return;  // a new file: nothing to destroy
+    throw OutputError(fmt::format("--out {}: cannot be opened: {}", file.string(), std::strerror(errno)));
+  }
+  struct stat status {};
+  if (::fstat(fd_, &status) != 0 || !S_ISREG(status.st_mode)) {
+    ::close(fd_);
+    throw OutputError(fmt::format("--out {}: is not a regular file; expected an HDF5 file or a new name", file.string()));
+  }
+  try {
+    lock_for_run(fd_, file, "--out",
+                 "another run is writing this file, or a program holds it open through the HDF5 library");
+  } catch (const OutputError&) {
+    ::close(fd_);
+    throw;
+  }
+}
+
+Hdf5Writer::Lock::~Lock() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+Hdf5Writer::Hdf5Writer(const std::filesystem::path& file, const std::string& scene_text)
+    : name_(file.string()), lock_(file), staged_(file, "--out") {
+  // No clean-up of the library at exit: it would flush a file whose write failed again (and HDF5
+  // 1.10 crashes closing it); every file is closed here, or abandoned.
+  H5dont_atexit();
   H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported here, not printed by the library
-  file_ = H5Fcreate(name_.c_str(), H5F_ACC_TRUNC, H5P_DEFAULT, H5P_DEFAULT);
-  if (file_ < 0) throw OutputError(fmt::format("--out {}: cannot create the HDF5 file", name_));
+  try {
+    create_file(scene_text);
+  } catch (const OutputError&) {
+    release();
+    throw;
+  }
+  whole_ = 1;
+  watch_trajectory(this);
+}
+
+// The file, its root's attributes stored densely (a scene beyond 64 KiB fits), and the `scene`
+// attribute, flushed.
+void Hdf5Writer::create_file(const std::string& scene_text) {
+  const hid_t creation = H5Pcreate(H5P_FILE_CREATE), access = H5Pcreate(H5P_FILE_ACCESS);
+  if (creation >= 0 && access >= 0 && H5Pset_attr_phase_change(creation, 0, 0) >= 0 &&
+      H5Pset_libver_bounds(access, H5F_LIBVER_V18, H5F_LIBVER_V18) >= 0)
+    file_ = H5Fcreate(staged_.temporary().c_str(), H5F_ACC_TRUNC, creation, access);
+  const std::string created = file_ < 0 ? hdf5_cause() : "";
+  if (access >= 0) H5Pclose(access);
+  if (creation >= 0) H5Pclose(creation);
+  if (file_ < 0) fail("created", created);
   const hid_t type = H5Tcopy(H5T_C_S1);
   const hid_t space = H5Screate(H5S_SCALAR);
   hid_t attribute = -1;
   const bool written = type >= 0 && space >= 0 && H5Tset_size(type, scene_text.size() + 1) >= 0 &&
                        (attribute = H5Acreate2(file_, "scene", type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0 &&
                        H5Awrite(attribute, type, scene_text.c_str()) >= 0;
+  const std::string cause = written ? "" : hdf5_cause();
   if (attribute >= 0) H5Aclose(attribute);
   if (space >= 0) H5Sclose(space);
   if (type >= 0) H5Tclose(type);
-  if (!written) {
-    release();
-    throw OutputError(fmt::format("--out {}: cannot write the scene attribute", name_));
-  }
+  if (!written) fail("given the scene attribute", cause);
+  if (H5Fflush(file_, H5F_SCOPE_GLOBAL) < 0) fail("flushed", hdf5_cause());
 }
 
-Hdf5Writer::~Hdf5Writer() { release(); }
+Hdf5Writer::~Hdf5Writer() {
+  watch_trajectory(nullptr);
+  if (!closed_ && !failed_) {
+    try {
+      close();  // the rows so far, e.g. of a run a plugin fault ended
+    } catch (const OutputError&) {
+    }
+  }
+  release();
+}
 
 void Hdf5Writer::release() noexcept {
   for (Dataset& d : datasets_)
     if (d.id >= 0) H5Dclose(d.id), d.id = -1;
   if (file_ >= 0) H5Fclose(file_), file_ = -1;
+}
+
+void Hdf5Writer::fail(const std::string& doing, const std::string& cause) {
+  whole_ = 0;
+  failed_ = true;
+  throw OutputError(fmt::format("--out {}: cannot be {}: {}", name_, doing, printable(cause)));
 }
 
 // Observable columns "momentum0", "momentum1", ... share the dataset "momentum" (rows x k); a
@@ -56,7 +141,9 @@ void Hdf5Writer::header(int point_size, int momentum_size, const std::vector<std
     else
       datasets_.push_back({base, 1, indexed, -1, {}});
   }
+  whole_ = 0;
   for (Dataset& d : datasets_) create(d);
+  flush();
 }
 
 void Hdf5Writer::create(Dataset& d) {
@@ -68,9 +155,10 @@ void Hdf5Writer::create(Dataset& d) {
   const hid_t properties = H5Pcreate(H5P_DATASET_CREATE);
   if (space >= 0 && properties >= 0 && H5Pset_chunk(properties, rank, chunk) >= 0)
     d.id = H5Dcreate2(file_, d.name.c_str(), H5T_NATIVE_DOUBLE, space, H5P_DEFAULT, properties, H5P_DEFAULT);
+  const std::string cause = d.id < 0 ? hdf5_cause() : "";
   if (properties >= 0) H5Pclose(properties);
   if (space >= 0) H5Sclose(space);
-  if (d.id < 0) throw OutputError(fmt::format("--out {}: cannot create the dataset '{}'", name_, d.name));
+  if (d.id < 0) fail(fmt::format("given the dataset '{}'", d.name), cause);
   d.pending.reserve(kBlockRows * static_cast<std::size_t>(d.width));
 }
 
@@ -96,29 +184,38 @@ void Hdf5Writer::append(Dataset& d) {
   written = written && file_space >= 0 && memory_space >= 0 &&
             H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, nullptr, count, nullptr) >= 0 &&
             H5Dwrite(d.id, H5T_NATIVE_DOUBLE, memory_space, file_space, H5P_DEFAULT, d.pending.data()) >= 0;
+  const std::string cause = written ? "" : hdf5_cause();
   if (memory_space >= 0) H5Sclose(memory_space);
   if (file_space >= 0) H5Sclose(file_space);
-  if (!written) throw OutputError(fmt::format("--out {}: cannot write the dataset '{}'", name_, d.name));
+  if (!written) fail(fmt::format("written (dataset '{}')", d.name), cause);
   d.pending.clear();
 }
 
 void Hdf5Writer::flush() {
-  if (file_ < 0) return;
+  if (file_ < 0 || failed_) return;
+  whole_ = 0;
   if (pending_rows_ > 0) {
     for (Dataset& d : datasets_) append(d);
     rows_ += pending_rows_;
     pending_rows_ = 0;
   }
-  if (H5Fflush(file_, H5F_SCOPE_GLOBAL) < 0) throw OutputError(fmt::format("--out {}: cannot flush the file", name_));
+  if (H5Fflush(file_, H5F_SCOPE_GLOBAL) < 0) fail("flushed", hdf5_cause());
+  whole_ = 1;
 }
 
 void Hdf5Writer::close() {
+  if (failed_) throw OutputError(fmt::format("--out {}: cannot be closed after a failed write", name_));
   flush();
+  whole_ = 0;
+  closed_ = true;
   bool closed = true;
   for (Dataset& d : datasets_)
     if (d.id >= 0) closed = H5Dclose(d.id) >= 0 && closed, d.id = -1;
   if (file_ >= 0) closed = H5Fclose(file_) >= 0 && closed, file_ = -1;
-  if (!closed) throw OutputError(fmt::format("--out {}: cannot close the file", name_));
+  if (!closed) fail("closed", hdf5_cause());
+  staged_.commit();
 }
+
+void Hdf5Writer::end_on_crash() noexcept { staged_.end_on_crash(whole_ != 0); }
 
 }  // namespace varia::host

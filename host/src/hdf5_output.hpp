@@ -1,23 +1,35 @@
 // The trajectory as HDF5 (spec "Outputs", `--out FILE.h5`), through the HDF5 C library from
 // Debian: datasets `t` (rows), `q` (rows x N), `p` (rows x M) and one per observable (`energy`;
 // `momentum` rows x k; `orthogonality`), rows as the CSV's, and the scene's JSON text as the
-// root's attribute `scene`. The datasets are chunked and grow: rows are buffered and appended in
-// blocks, and the file is flushed after each block, so that when a run ends early (exit 4, an
-// interruption) the rows written so far are readable. Every HDF5 call is checked: a failure
-// throws OutputError naming the file.
+// root's attribute `scene` (stored densely, so a scene of any size fits: the file format of HDF5
+// 1.8). The datasets are chunked and grow: rows are buffered and appended in blocks, and the file is
+// flushed after each block.
+//
+// The file is written as a StagedFile (output.hpp): under a temporary name beside the target,
+// renamed over it when the run ends, also early (exit 3, 4, an interruption: the rows so far), and,
+// when a plugin ends the process, as it was at its last flush. A run refused or whose writes fail
+// leaves the old file as it was. Every HDF5 call is checked: a failure throws OutputError naming
+// the file and the cause HDF5 gives.
 #pragma once
 
+#include <csignal>
 #include <filesystem>
 #include <string>
 #include <vector>
 
+#include "output.hpp"
+
 namespace varia::host {
 
-class Hdf5Writer {
+class Hdf5Writer final : public CrashSafeOutput {
  public:
-  // Creates (truncates) the file and writes the `scene` attribute. Throws OutputError.
+  // Refuses (OutputError) a file that another run is writing or a program holds open through HDF5
+  // (their lock), or that is not a regular file; then creates the temporary file with the `scene`
+  // attribute.
   Hdf5Writer(const std::filesystem::path& file, const std::string& scene_text);
-  ~Hdf5Writer();  // closes what is open, reporting nothing: call close() to have errors reported
+  // Unless close() was called: closes and renames the file when every write so far succeeded (the
+  // rows so far), else removes it. Reports nothing: call close() to have errors reported.
+  ~Hdf5Writer();
   Hdf5Writer(const Hdf5Writer&) = delete;
   Hdf5Writer& operator=(const Hdf5Writer&) = delete;
 
@@ -28,8 +40,11 @@ class Hdf5Writer {
   void row(double t, const double* q, int nq, const double* p, int np, const std::vector<double>& rest);
   // Appends the buffered rows and flushes the file.
   void flush();
-  // flush(), then closes every object, checked.
+  // flush(), closes every object, checked, and renames the file over the target.
   void close();
+  // The file as it was at its last flush, renamed over the target; removed if a write was under
+  // way. Only rename(2) or unlink(2).
+  void end_on_crash() noexcept override;
 
  private:
   struct Dataset {
@@ -39,14 +54,31 @@ class Hdf5Writer {
     long long id = -1;
     std::vector<double> pending;  // buffered rows, row-major
   };
+  // The target's lock, held for the run (none while the target does not exist).
+  class Lock {
+   public:
+    explicit Lock(const std::filesystem::path& file);
+    ~Lock();
+    Lock(const Lock&) = delete;
+    Lock& operator=(const Lock&) = delete;
+
+   private:
+    int fd_ = -1;
+  };
+  void create_file(const std::string& scene_text);
   void create(Dataset& d);
   void append(Dataset& d);
   void release() noexcept;
+  [[noreturn]] void fail(const std::string& doing, const std::string& cause);
 
   std::string name_;
+  Lock lock_;
+  StagedFile staged_;
   long long file_ = -1;
   std::vector<Dataset> datasets_;  // t, q, p, then the observables
   long long rows_ = 0, pending_rows_ = 0;
+  volatile std::sig_atomic_t whole_ = 0;  // the file on disk is as its last flush left it
+  bool failed_ = false, closed_ = false;
 };
 
 }  // namespace varia::host

@@ -67,32 +67,6 @@ std::string temporary_template(const fs::path& target) {
   return (directory / ("." + name + std::string(kSuffix))).string();
 }
 
-// Writes `text` to a temporary file in the directory of `target` and renames it over `target`.
-void replace_file(const fs::path& target, std::string_view text, std::string_view what) {
-  struct stat existing {};
-  const bool exists = ::stat(target.c_str(), &existing) == 0;
-  std::string temporary = temporary_template(target);
-  const int fd = ::mkstemp(temporary.data());
-  if (fd < 0) fail(what, target, "written", errno);
-  const auto abandon = [&](int error) {
-    ::close(fd);
-    ::unlink(temporary.c_str());
-    fail(what, target, "written", error);
-  };
-  if (::fchmod(fd, exists ? existing.st_mode & 07777 : default_file_mode()) != 0) abandon(errno);
-  if (!write_all(fd, text)) abandon(errno);
-  if (::close(fd) != 0) {
-    const int error = errno;
-    ::unlink(temporary.c_str());
-    fail(what, target, "written", error);
-  }
-  if (::rename(temporary.c_str(), target.c_str()) != 0) {
-    const int error = errno;
-    ::unlink(temporary.c_str());
-    fail(what, target, "written", error);
-  }
-}
-
 // The file that writing `file` replaces: `file` itself, or at the end of its symbolic links (also
 // of a link naming a file that is not there yet), followed as open(2) follows them (at most 40).
 fs::path link_target(const fs::path& file, std::string_view what) {
@@ -144,6 +118,50 @@ bool same_file(const fs::path& a, const fs::path& b) {
 
 }  // namespace
 
+StagedFile::StagedFile(const fs::path& file, std::string_view what)
+    : what_(what), target_(link_target(file, what)), temporary_(temporary_template(target_)) {
+  struct stat existing {};
+  const bool exists = ::stat(target_.c_str(), &existing) == 0;
+  fd_ = ::mkstemp(temporary_.data());
+  if (fd_ < 0) fail(what_, target_, "written", errno);
+  if (::fchmod(fd_, exists ? existing.st_mode & 07777 : default_file_mode()) != 0) abandon(errno);
+}
+
+StagedFile::~StagedFile() {
+  if (committed_) return;
+  if (fd_ >= 0) ::close(fd_);
+  ::unlink(temporary_.c_str());
+}
+
+void StagedFile::abandon(int error) {
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = -1;
+  ::unlink(temporary_.c_str());
+  committed_ = true;  // nothing left to remove
+  fail(what_, target_, "written", error);
+}
+
+void StagedFile::commit() {
+  const int fd = fd_;
+  fd_ = -1;
+  if (::close(fd) != 0) abandon(errno);
+  if (::rename(temporary_.c_str(), target_.c_str()) != 0) abandon(errno);
+  committed_ = true;
+}
+
+void StagedFile::end_on_crash(bool keep) noexcept {
+  if (committed_) return;
+  if (!keep || ::rename(temporary_.c_str(), target_.c_str()) != 0) ::unlink(temporary_.c_str());
+}
+
+void lock_for_run(int fd, const fs::path& file, std::string_view flag, std::string_view holders) {
+  if (::flock(fd, LOCK_EX | LOCK_NB) == 0) return;
+  const int error = errno;
+  if (error == EWOULDBLOCK)
+    throw OutputError(fmt::format("{} {}: {}; expected a file of its own", flag, file.string(), holders));
+  fail(flag, file, "locked", error);
+}
+
 CsvWriter::CsvWriter(const fs::path& file) : name_(file.string()) {
   open(file);
   watch_trajectory(this);
@@ -162,13 +180,11 @@ void CsvWriter::open(const fs::path& file) {
   struct stat status {};
   regular_ = ::fstat(fd_, &status) == 0 && S_ISREG(status.st_mode);
   if (!regular_) return;
-  if (::flock(fd_, LOCK_EX | LOCK_NB) != 0) {
-    const int error = errno;
+  try {
+    lock_for_run(fd_, file, "--out", "another run is writing this file");
+  } catch (const OutputError&) {
     ::close(fd_);
-    if (error == EWOULDBLOCK)
-      throw OutputError(fmt::format("--out {}: another run is writing this file; expected a file of its own",
-                                    name_));
-    fail("--out", file, "locked", error);
+    throw;
   }
   if (::ftruncate(fd_, 0) != 0) {
     const int error = errno;
@@ -232,7 +248,7 @@ bool CsvWriter::write_rows(std::string_view rows, int& error) noexcept {
   return false;
 }
 
-void CsvWriter::write_whole_rows() noexcept {
+void CsvWriter::end_on_crash() noexcept {
   if (fd_ < 0 || failed_) return;
   const auto last_newline = std::string_view(buffer_.data(), buffer_.size()).rfind('\n');
   int error = 0;
@@ -255,7 +271,9 @@ void write_output(const fs::path& file, std::string_view text, std::string_view 
   std::error_code ec;
   const auto status = fs::status(file, ec);
   if (fs::exists(status) && !fs::is_regular_file(status)) return write_in_place(file, text, what);
-  replace_file(link_target(file, what), text, what);
+  StagedFile staged(file, what);
+  if (!write_all(staged.fd(), text)) fail(what, staged.target(), "written", errno);
+  staged.commit();
 }
 
 std::string printable(std::string_view text) {

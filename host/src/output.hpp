@@ -18,7 +18,55 @@
 
 namespace varia::host {
 
-class CsvWriter {
+// A trajectory output that the crash handlers (crash.hpp) leave whole when a plugin ends the
+// process. end_on_crash() may only make async-signal-safe calls.
+class CrashSafeOutput {
+ public:
+  virtual void end_on_crash() noexcept = 0;
+
+ protected:
+  ~CrashSafeOutput() = default;
+};
+
+// A file written under a temporary name beside its target and renamed over the target when whole,
+// so that a reader sees the old file or the new one, never a part, and a run that fails before
+// commit() leaves the old file as it was. A symbolic link keeps pointing where it did, also when
+// what it names is not there yet: the file it names is replaced. The temporary file has the mode of
+// the file it replaces (a new one: what the umask leaves of 0666).
+class StagedFile {
+ public:
+  // Creates the temporary file. `what` names the output in messages (e.g. "--summary"). Throws
+  // OutputError.
+  StagedFile(const std::filesystem::path& file, std::string_view what);
+  ~StagedFile();  // removes the temporary file unless it was committed
+  StagedFile(const StagedFile&) = delete;
+  StagedFile& operator=(const StagedFile&) = delete;
+
+  int fd() const { return fd_; }  // open on the temporary file until commit()
+  const std::string& temporary() const { return temporary_; }
+  const std::filesystem::path& target() const { return target_; }  // at the end of the links
+  // Closes the descriptor (checked) and renames the temporary file over the target. Throws
+  // OutputError (the temporary file then removed).
+  void commit();
+  // For the crash handlers: renames the temporary file over the target (keep), or removes it.
+  // Only rename(2) or unlink(2), which are async-signal-safe.
+  void end_on_crash(bool keep) noexcept;
+
+ private:
+  [[noreturn]] void abandon(int error);
+  std::string what_;
+  std::filesystem::path target_;
+  std::string temporary_;
+  int fd_ = -1;
+  bool committed_ = false;
+};
+
+// Locks the open regular file `fd` (named `file` as `flag`) for this run, without waiting: a second
+// run writing the same file is refused (OutputError naming `holders`, who may hold it) before it
+// touches the file.
+void lock_for_run(int fd, const std::filesystem::path& file, std::string_view flag, std::string_view holders);
+
+class CsvWriter final : public CrashSafeOutput {
  public:
   // "-" writes to stdout (results()). A regular file is locked for the run: a second run writing the same
   // file is refused (OutputError) before it truncates it. Throws OutputError when the file
@@ -39,7 +87,7 @@ class CsvWriter {
   void close();
   // Writes the buffered whole rows, reporting nothing: for the crash handlers (crash.hpp), when a
   // plugin ends the process. It only calls write(2) and ftruncate(2), which are async-signal-safe.
-  void write_whole_rows() noexcept;
+  void end_on_crash() noexcept override;
 
  private:
   void open(const std::filesystem::path& file);
@@ -56,10 +104,9 @@ class CsvWriter {
 
 inline std::vector<double> as_vector(const Eigen::VectorXd& x) { return {x.data(), x.data() + x.size()}; }
 
-// Writes `text` to `file` ("-": stdout): a regular file (or a new one) through a temporary file
-// renamed over it, anything else (a device, a pipe) directly. A symbolic link keeps pointing where
-// it did, also when what it names is not there yet: the file it names is written. `what` names the output in messages
-// (e.g. "--summary"). Throws OutputError.
+// Writes `text` to `file` ("-": stdout): a regular file (or a new one) through a StagedFile,
+// anything else (a device, a pipe) directly. `what` names the output in messages (e.g.
+// "--summary"). Throws OutputError.
 void write_output(const std::filesystem::path& file, std::string_view text, std::string_view what);
 
 // `text` as a terminal or a one-line message may show it: control characters (newlines, terminal

@@ -247,7 +247,7 @@ class Stepper {
     if (observing_) return 0;
     const long k = trajectory_.steps();
     long due = scene_.steps;
-    if (csv_ || plot_) due = std::min(due, (k / scene_.output_every + 1) * scene_.output_every);
+    if (csv_ || h5_ || plot_) due = std::min(due, (k / scene_.output_every + 1) * scene_.output_every);
     return std::clamp(due - k - 1, 0L, kStretch);
   }
 

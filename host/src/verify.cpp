@@ -12,6 +12,7 @@
 
 #include "commands.hpp"
 #include "constructions/parts.hpp"
+#include "interrupt.hpp"
 #include "registry.hpp"
 #include "varia/core/trajectory.hpp"
 
@@ -73,9 +74,16 @@ std::vector<double> steps_of(const Context& x, std::initializer_list<int> powers
   return h;
 }
 
-// Runs `measure`; a numerical failure inside it names the property and the step size.
+// Verify ends between its measurements when a signal asked to stop (Interrupted: exit 128 + the
+// signal, docs/security.md, "Interrupts").
+void stop_before(const char* property, double h) {
+  if (interruption() != 0) stop_if_interrupted(fmt::format("before verify's {} at h = {:.4g}", property, h));
+}
+
+// Runs `measure` (stop_before it); a numerical failure inside it names the property and the step size.
 template <class F>
 auto within(const char* property, double h, F&& measure) {
+  stop_before(property, h);
   try {
     return measure();
   } catch (const StepFailure& e) {
@@ -280,9 +288,14 @@ ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& refere
 }
 
 // The order ladder's start and ceiling: the scene's step (twice it for L_d, whose error is local)
-// and kRaise times that.
-OrderFit ladder(Context& x, const ErrorAt& error_at, double top, double floor, const NoiseAt& noise_at = {}) {
-  return measure_order(error_at, top, kRaise * top, floor, x.given_h, noise_at);
+// and kRaise times that; `property` measured at each step size (stop_before it).
+OrderFit ladder(Context& x, const char* property, const ErrorAt& error_at, double top, double floor,
+                const NoiseAt& noise_at = {}) {
+  const ErrorAt stopping = [&](double& h) {
+    stop_before(property, h);
+    return error_at(h);
+  };
+  return measure_order(stopping, top, kRaise * top, floor, x.given_h, noise_at);
 }
 
 // The slope of |L_d - L_d^E| / (h |L|) against h: the order of L_d (paper, sec. 1: variational
@@ -298,7 +311,7 @@ PropertyCheck ld_order(Context& x) {
   for (const ExactLd::Base& base : exact.bases) {
     double scale = 0.0;  // |L| along the curve, fixed at the first (largest) step size
     fits.push_back(ladder(
-        x,
+        x, "ld_order",
         [&](double& h) {
           double LdE = 0.0, Ld = 0.0;
           exact.at(base, h, q1, LdE);
@@ -387,7 +400,7 @@ PropertyCheck global_order(Context& x) {
   const std::string reference = reference_state(x, T, std::lround(16 * kOrderSpan), qe, pe, uncertainty);
   const double scale = 1.0 + x.a.q0.lpNorm<Eigen::Infinity>() + x.a.p0.lpNorm<Eigen::Infinity>();
   const OrderFit fit = ladder(
-      x,
+      x, "global_order",
       [&](double& h) {
         const long steps = std::max(1L, std::lround(T / h));
         h = T / static_cast<double>(steps);

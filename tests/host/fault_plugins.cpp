@@ -154,6 +154,44 @@ TEST_CASE("plugins in files or directories writable by group or others are refus
   }
 }
 
+// Issue 43, item 15: on a cluster, a project's directories are often writable by its group and setgid.
+TEST_CASE("plugins under a group-writable setgid directory are loaded when VARIA_TRUSTED_PLUGIN_DIRS names it") {
+  using P = fs::perms;
+  TempDir top;
+  const fs::path project = top / "project", plugins = project / "plugins", plugin = plugins / "fault_returns_nan.so";
+  fs::create_directories(plugins);
+  fs::copy_file(kFaultPluginDir / "fault_returns_nan.so", plugin);
+  fs::permissions(plugin, P::owner_all | P::group_all);
+  for (const fs::path& d : {project, plugins}) fs::permissions(d, P::owner_all | P::group_all | P::set_gid);
+  const std::string listing = varia() + " plugins --plugin-path " + quoted(plugins);
+  const std::string trusting = "VARIA_TRUSTED_PLUGIN_DIRS=" + quoted(project) + " ";
+  auto outcome = run_shell(listing);
+  CHECK(outcome.code == 0);
+  CHECK(contains(outcome.out, plugin.string() + ": not trusted: writable by group or others (mode 0770)"));
+  CHECK(contains(outcome.out, "VARIA_TRUSTED_PLUGIN_DIRS"));  // the refusal says how to trust it
+  CHECK_FALSE(contains(outcome.out, "fault-nan"));
+  // Named (the project: everything under it), the plugin is trusted; the directories above it are
+  // still checked, and are the test's own.
+  outcome = run_shell(trusting + listing);
+  CHECK(outcome.code == 0);
+  CHECK(contains(outcome.out, "fault-nan"));
+  CHECK_FALSE(contains(outcome.out, "not trusted"));
+  // Writable by others stays refused, named or not.
+  fs::permissions(plugins, P::owner_all | P::group_all | P::others_all | P::set_gid);
+  outcome = run_shell(trusting + listing);
+  CHECK(contains(outcome.out, plugin.string() + ": not trusted: its directory " + plugins.string() +
+                                  " is writable by group or others (mode 2777)"));
+  CHECK_FALSE(contains(outcome.out, "fault-nan"));
+  // An entry that is not an absolute path of a directory is bad input.
+  for (const std::string& entry : {std::string("project"), (top / "missing").string(), plugin.string()}) {
+    CAPTURE(entry);
+    outcome = run_shell("VARIA_TRUSTED_PLUGIN_DIRS=" + quoted(fs::path(entry)) + " " + listing);
+    CHECK(outcome.code == 2);
+    check_one_error_line(outcome, "VARIA_TRUSTED_PLUGIN_DIRS: '" + entry +
+                                      "': expected absolute paths of directories, separated by ':'");
+  }
+}
+
 // As sshd's StrictModes: the file a link leads to, every directory above it, and the owners.
 TEST_CASE("plugins behind a link, under a writable parent or owned by another user are refused") {
   struct Layout {

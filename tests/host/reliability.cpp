@@ -30,20 +30,6 @@ json oscillator_scene() {
     "initial": {"q": [1.0], "p": [0.0]}, "step": 0.1, "t_end": 2, "observe": ["energy"]})");
 }
 
-// Runs `shell` (a /bin/sh command line, run from the source directory) with stdout and stderr
-// captured, unless the command redirects them itself.
-Outcome run_shell(const std::string& shell) {
-  TempDir dir;
-  const std::string command = "cd '" + kSourceDir.string() + "' && { " + shell + " ; } > '" +
-                              (dir / "stdout").string() + "' 2> '" + (dir / "stderr").string() + "'";
-  const int status = std::system(command.c_str());
-  return Outcome{WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(dir / "stdout"), read_file(dir / "stderr")};
-}
-
-std::string varia() { return "'" + varia_program().string() + "'"; }
-
-std::string quoted(const fs::path& file) { return "'" + file.string() + "'"; }
-
 // Every line ends with a newline and has as many cells as the header.
 void check_whole_rows(const std::string& csv) {
   REQUIRE_FALSE(csv.empty());
@@ -179,8 +165,9 @@ pid_t start_varia(const std::vector<std::string>& arguments, const TempDir& dir)
   return pid;
 }
 
-TEST_CASE("SIGINT and SIGTERM end a run with whole rows, a run record noting it, exit 130 and 143") {
-  for (const auto& [signal, code] : {std::pair{SIGINT, 130}, std::pair{SIGTERM, 143}}) {
+TEST_CASE("SIGINT, SIGTERM and SIGHUP end a run with whole rows, a run record noting it, exit 130, 143 and 129") {
+  for (const auto& [signal, code, name] :
+       {std::tuple{SIGINT, 130, "SIGINT"}, std::tuple{SIGTERM, 143, "SIGTERM"}, std::tuple{SIGHUP, 129, "SIGHUP"}}) {
     CAPTURE(signal);
     TempDir dir;
     json scene = oscillator_scene();
@@ -206,10 +193,36 @@ TEST_CASE("SIGINT and SIGTERM end a run with whole rows, a run record noting it,
     REQUIRE(fs::exists(dir / "r.json"));
     const json record = json::parse(read_file(dir / "r.json"));
     REQUIRE(record.contains("interrupted"));
-    CHECK(record["interrupted"]["signal"] == (signal == SIGINT ? "SIGINT" : "SIGTERM"));
+    CHECK(record["interrupted"]["signal"] == name);
     CHECK(record["steps"].get<long>() + 2 == static_cast<long>(lines_of(csv).size()));  // header, step 0
     CHECK(contains(read_file(dir / "stderr"), "interrupted"));
   }
+}
+
+// Issue 43, item 11: verify looked at the flag only when it had finished, so `timeout N varia verify`
+// ran to the end of every measurement.
+TEST_CASE("SIGTERM ends verify between its measurements, exit 143, no --json written") {
+  TempDir dir;
+  // A verify of many seconds, each of its measurements far shorter.
+  const pid_t pid = start_varia({"verify", "scenes/morse-chain.json", "--json", (dir / "v.json").string()}, dir);
+  REQUIRE(pid > 0);
+  std::this_thread::sleep_for(std::chrono::seconds(2));  // loaded and measuring
+  const auto signalled = std::chrono::steady_clock::now();
+  ::kill(pid, SIGTERM);
+  int status = 0;
+  pid_t ended = 0;
+  while ((ended = ::waitpid(pid, &status, WNOHANG)) == 0 &&
+         std::chrono::steady_clock::now() - signalled < std::chrono::seconds(20))
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  if (ended == 0) {  // still measuring: end it, and fail
+    ::kill(pid, SIGKILL);
+    ::waitpid(pid, &status, 0);
+  }
+  REQUIRE(ended == pid);
+  REQUIRE(WIFEXITED(status));
+  CHECK(WEXITSTATUS(status) == 143);
+  check_one_error_line(Outcome{143, "", read_file(dir / "stderr")}, "interrupted by SIGTERM before verify's ");
+  CHECK_FALSE(fs::exists(dir / "v.json"));
 }
 
 // ---- 12: collisions and atomic records -----------------------------------------------------------

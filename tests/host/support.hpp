@@ -93,6 +93,20 @@ inline Outcome run_varia(const std::string& arguments) {
   return outcome;
 }
 
+// Runs `shell` (a /bin/sh command line, run from the source directory) with stdout and stderr
+// captured, unless the command redirects them itself.
+inline Outcome run_shell(const std::string& shell) {
+  TempDir dir;
+  const std::string command = "cd '" + kSourceDir.string() + "' && { " + shell + " ; } > '" +
+                              (dir / "stdout").string() + "' 2> '" + (dir / "stderr").string() + "'";
+  const int status = std::system(command.c_str());
+  return Outcome{WIFEXITED(status) ? WEXITSTATUS(status) : -1, read_file(dir / "stdout"), read_file(dir / "stderr")};
+}
+
+// The program under test and a file name, quoted for run_shell.
+inline std::string varia() { return "'" + varia_program().string() + "'"; }
+inline std::string quoted(const fs::path& file) { return "'" + file.string() + "'"; }
+
 inline bool contains(const std::string& text, const std::string& part) {
   return text.find(part) != std::string::npos;
 }
