@@ -114,7 +114,7 @@ CLI::App* subcommand(CLI::App& app, Options& o, const char* name, const char* de
 }
 
 void add_scene(CLI::App* sub, std::string& scene) {
-  sub->add_option("SCENE", scene, "the scene file (JSON; see schemas/scene.schema.json)")
+  sub->add_option("SCENE", scene, "the scene file (JSON; its schema: scene.schema.json, see varia --help)")
       ->required()
       ->type_name("SCENE.json");
 }
@@ -239,6 +239,9 @@ int run_command_line(int argc, char** argv, const std::function<bool(const std::
       "4 numerical failure, 128 + N interrupted by signal N (130 SIGINT, 143 SIGTERM, 129 SIGHUP).\n"
       "Plugins are searched in the bundled directory, then --plugin-path, then VARIA_PLUGIN_PATH;\n"
       "directories a group may write are trusted under those named in VARIA_TRUSTED_PLUGIN_DIRS.\n"
+      "The scene schema and example scenes: PREFIX/share/varia/scene.schema.json and\n"
+      "PREFIX/share/varia/scenes/ (PREFIX: where varia is installed, bin/varia's parent), or\n"
+      "schemas/scene.schema.json and scenes/ in the source tree.\n"
       "Example:\n  varia run scenes/default.json --out traj.csv --summary run.json");
   Options options;
   Command chosen;

@@ -23,12 +23,24 @@ done
 listed=$("$varia" plugins --json | jq length)
 [ "$listed" -eq "$installed" ] || fail "varia plugins --json lists $listed plugins of the $installed installed"
 
+# The scene schema and the example scenes that --help names, installed: every scene valid.
+share=$work/prefix/share/varia
+jq -e '.type == "object"' "$share/scene.schema.json" >/dev/null || fail "no scene schema in $share"
+"$varia" --help | grep -q "share/varia/scenes/" || fail "varia --help does not name the installed scenes"
+scenes=0
+while IFS= read -r -d '' scene; do
+  "$varia" validate "$scene" >/dev/null || fail "the installed scene $scene is not valid"
+  scenes=$((scenes + 1))
+done < <(find "$share/scenes" -name '*.json' -print0)
+[ "$scenes" -gt 20 ] || fail "only $scenes example scenes installed in $share/scenes"
+[ ! -e "$share/scenes/bad" ] || fail "the refused scenes of scenes/bad are installed"
+
 # Run: only the files the scene names are opened.
-LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld" "$varia" run "$source/scenes/default.json" --quiet \
+LD_DEBUG=files LD_DEBUG_OUTPUT="$work/ld" "$varia" run "$share/scenes/default.json" --quiet \
   --summary "$work/run.json" --out "$work/run.csv"
 opened=$(cat "$work"/ld.* | grep -o "file=$plugins/[^ ]*\.so \[0\];  dynamically loaded" | sort -u | wc -l)
 named=$(jq '.plugins_loaded | length' "$work/run.json")
 [ "$named" -ge 1 ] || fail "the run record names no plugin loaded"
 [ "$opened" -eq "$named" ] || fail "the run opened $opened plugin files of $installed for the $named it needs: $(jq -c .plugins_loaded "$work/run.json")"
 [ "$(wc -l <"$work/run.csv")" -eq 202 ] || fail "the trajectory has $(wc -l <"$work/run.csv") lines, not 202"
-echo "stripped tree: $installed plugins installed and listed; the default scene opened $opened ($(jq -c .plugins_loaded "$work/run.json"))"
+echo "stripped tree: $installed plugins installed and listed, $scenes example scenes valid; the default scene opened $opened ($(jq -c .plugins_loaded "$work/run.json"))"
