@@ -14,6 +14,7 @@
 #include "tests/sdk/morse_chain.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/shooting.hpp"
+#include "varia/core/trajectory.hpp"
 #include "varia/sdk/runge_kutta.hpp"
 
 namespace {
@@ -24,19 +25,14 @@ struct Timing {
   double seconds_per_step, iterations;
 };
 
-// The time per step of `steps` steps of h from (q, p), after one untimed step.
-Timing time_steps(varia::DiscreteHamiltonianMap& map, const varia::SolverStatistics& statistics, VectorXd q,
-                  VectorXd p, double h, int steps) {
-  VectorXd q1(q.size()), p1(p.size());
-  map.step(q.data(), p.data(), h, q1.data(), p1.data());
-  q.swap(q1);
-  p.swap(p1);
+// The time per step of `steps` steps of h from (q, p) by the trajectory driver, after one untimed
+// step.
+Timing time_steps(varia::DiscreteHamiltonianMap& map, const varia::SolverStatistics& statistics, const VectorXd& q,
+                  const VectorXd& p, double h, int steps) {
+  varia::Trajectory trajectory(map, q, p, 0.0, h);
+  trajectory.step();
   const auto start = std::chrono::steady_clock::now();
-  for (int k = 0; k < steps; ++k) {
-    map.step(q.data(), p.data(), h, q1.data(), p1.data());
-    q.swap(q1);
-    p.swap(p1);
-  }
+  trajectory.advance(steps);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   return {seconds / steps, statistics.mean()};
 }

@@ -165,10 +165,9 @@ class AutodiffLagrangian : public Lagrangian {
       if constexpr (kFixed) {
         if constexpr (kFixedJetVariables > 0)
           if (jet_variables(q, v) == kFixedJetVariables) return at_fixed_jets<kFixedJetVariables>(q, v, value, gradient);
-        at_jets(q, v, value, gradient);
+        at_stack_jets(q, v, value, gradient);
       } else {
-        for (int first = 0; first < m_ + n_; first += kJetDirections)
-          jet_first_order(jet_q_, jet_v_, q, v, first, first == 0 ? value : nullptr, gradient);
+        at_jets(jet_q_, jet_v_, q, v, value, gradient);
       }
     });
   }
@@ -334,7 +333,8 @@ class AutodiffLagrangian : public Lagrangian {
   // numbers each, every loop of the chain rule of a fixed length), converted from and to Jet2.
   // A shooting pass's jets have up to twice the manifold's dimension in variables (shooting.hpp).
   // The model reads only the first m + n inputs, which are set; GCC cannot see that, and warns of
-  // the others (uninitialized FixedJet's, jet.hpp). Filling them would cost a large part of the evaluation.
+  // the others (uninitialized FixedJet's, jet.hpp). Filling them would cost a large part of the
+  // evaluation.
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wuninitialized"
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
@@ -343,17 +343,22 @@ class AutodiffLagrangian : public Lagrangian {
     std::array<FixedJet<N>, kStackVariables> inputs, outputs;
     FixedJet<N> fixed_value;
     for (int i = 0; i < m_ + n_; ++i) inputs[i] = FixedJet<N>(at(q, v, m_, i));
-    at_jets(inputs.data(), inputs.data() + m_, value != nullptr ? &fixed_value : nullptr, outputs.data());
+    at_stack_jets(inputs.data(), inputs.data() + m_, value != nullptr ? &fixed_value : nullptr, outputs.data());
     if (value != nullptr) fixed_value.to_jet2(*value);
     for (int i = 0; i < m_ + n_; ++i) outputs[i].to_jet2(gradient[i]);
   }
-  // At jets J (sizes given at compile time): one pass of forward mode over every number of (q, v)
-  // up to two of them, else one per block of kJetDirections, over dual numbers on the stack.
+  // At jets J (sizes given at compile time), over dual numbers on the stack: one pass of forward
+  // mode over every number of (q, v) up to two of them, else one per block of kJetDirections.
   template <class J>
-  void at_jets(const J* q, const J* v, J* value, J* gradient) const {
+  void at_stack_jets(const J* q, const J* v, J* value, J* gradient) const {
     constexpr int K = Positions + Velocities <= 2 ? 2 : kJetDirections;
     Vec<JetDual<K, J>> qd(m_), vd(n_);
-    for (int first = 0; first < m_ + n_; first += K)
+    at_jets(qd, vd, q, v, value, gradient);
+  }
+  // At jets J over the dual inputs qd, vd: one pass of forward mode per block of their directions.
+  template <class JD, class J>
+  void at_jets(Vec<JD>& qd, Vec<JD>& vd, const J* q, const J* v, J* value, J* gradient) const {
+    for (int first = 0; first < m_ + n_; first += JD::DerType::MaxRowsAtCompileTime)
       jet_first_order(qd, vd, q, v, first, first == 0 ? value : nullptr, gradient);
   }
   // L (if value is not null) and the derivatives in the numbers first .. first + K - 1 of (q, v)

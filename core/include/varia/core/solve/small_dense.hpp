@@ -2,8 +2,8 @@
 // fixed-size matrix (cofactors: no pivot search, no blocking), so that a solve is a product of a
 // few flops; above, Eigen's PartialPivLU. Eigen's PartialPivLU of a dynamic matrix pays its
 // blocking and dispatch at every size, and a solve with a matrix right-hand side packs it as for
-// a large product, which dominates a small system's step (bench/README.md). A singular A gives non-finite solutions in either case;
-// the callers' solves check their residuals. Arguments whose size is fixed at compile time take
+// a large product, which dominates a small system's step (bench/README.md). A singular A gives
+// non-finite solutions in either case; the callers' solves check their residuals. Arguments whose size is fixed at compile time take
 // fixed-size code (the shooting step at n <= 4, shooting.cpp).
 #pragma once
 
