@@ -1,6 +1,7 @@
 #include "observer.hpp"
 
 #include <Eigen/Core>
+#include <fmt/format.h>
 #include <algorithm>
 #include <cmath>
 #include <string>
@@ -9,7 +10,8 @@ namespace varia::host {
 
 Observer::Observer(const Observe& observe, const Manifold& manifold, Lagrangian& lagrangian,
                    const Eigen::VectorXd& v0, const SolverOptions& options)
-    : what_(observe), manifold_(manifold), lagrangian_(lagrangian), evaluator_(lagrangian), options_(options), v_(v0) {
+    : what_(observe), manifold_(manifold), lagrangian_(lagrangian), evaluator_(lagrangian), options_(options),
+      v_(v0.size() == lagrangian.velocity_size() ? v0 : Eigen::VectorXd::Zero(lagrangian.velocity_size())) {
   if (what_.momentum) momentum_size_ = lagrangian.momentum_size();
 }
 
@@ -21,17 +23,37 @@ std::vector<std::string> Observer::columns() const {
   return names;
 }
 
+double Observer::energy(const double* q, const double* p) {
+  evaluator_.inverse_legendre(q, p, v_.data(), options_);  // warm-started from the last v
+  return evaluator_.energy(q, v_.data(), p);
+}
+
 void Observer::observe(const double* q, const double* p) {
   values_.clear();
-  if (what_.energy || what_.momentum)
-    evaluator_.inverse_legendre(q, p, v_.data(), options_);  // warm-started from the last v
-  if (what_.energy) values_.push_back(evaluator_.energy(q, v_.data(), p));
+  if (what_.energy) values_.push_back(energy(q, p));
+  else if (what_.momentum) evaluator_.inverse_legendre(q, p, v_.data(), options_);
   if (what_.momentum) {
     values_.resize(values_.size() + momentum_size_);
     check(lagrangian_, lagrangian_.momentum(q, v_.data(), values_.data() + values_.size() - momentum_size_), "momentum");
   }
   if (what_.orthogonality) values_.push_back(manifold_.constraint_error(q));  // ||I - R^T R||_F on SO3 and SE3
   update_errors();
+}
+
+void Observer::check_energy_range(const double* q, const double* p) {
+  const double E = what_.energy ? values_.front() : energy(q, p);
+  const int n = static_cast<int>(v_.size());
+  if (range_scale_ < 0.0) {
+    range_energy_ = E;
+    range_scale_ = std::abs(Eigen::Map<const Eigen::VectorXd>(p, n).dot(v_)) + std::abs(evaluator_.value(q, v_.data()));
+  }
+  if (const double error = std::abs(E - range_energy_); range_scale_ > 0.0 && !(error <= range_scale_))
+    throw NumericalFailure(
+        fmt::format("the energy error |E - E0| = {:.3g} exceeds the energy's scale |<p0, v0>| + |L(q0, v0)| = {:.3g}: "
+                    "the run left every sane range (a step too large for the method, or step equations whose roots "
+                    "are not continuous in h); take a smaller step",
+                    error, range_scale_),
+        error);
 }
 
 void Observer::update_errors() {

@@ -16,7 +16,8 @@ namespace varia::host {
 
 class Observer {
  public:
-  // v0 is the initial velocity, the first warm start of the inverse Legendre transform.
+  // v0 is the initial velocity, the first warm start of the inverse Legendre transform (zero when
+  // it is not given: the assembly forms v0 only where the scene observes the energy or momentum).
   Observer(const Observe& observe, const Manifold& manifold, Lagrangian& lagrangian, const Eigen::VectorXd& v0,
            const SolverOptions& options);
   std::vector<std::string> columns() const;  // energy; momentum0..; orthogonality
@@ -28,8 +29,17 @@ class Observer {
   double momentum_error() const { return momentum_error_; }
   double orthogonality_error() const { return orthogonality_error_; }
 
+  // The sane-range check of a run without forces: the flow conserves the energy and a variational
+  // integrator keeps its error bounded (O(h^r) by backward error analysis), so an error beyond the
+  // energy's own scale at the first check, |<p, v>| + |L| (which bounds |E| there), is not a
+  // result but a failure: a step too large for the method, or step equations whose roots are not
+  // continuous in h. Throws NumericalFailure saying so; a start where that scale is 0 is not checked.
+  // Reuses the energy of the last observe() at the same point when the energy is observed.
+  void check_energy_range(const double* q, const double* p);
+
  private:
   void update_errors();
+  double energy(const double* q, const double* p);  // with v from the inverse Legendre transform
   Observe what_;
   const Manifold& manifold_;  // its constraint_error is the orthogonality observable
   Lagrangian& lagrangian_;
@@ -39,6 +49,7 @@ class Observer {
   int momentum_size_ = 0;
   std::vector<double> values_, initial_;
   double energy_error_ = 0.0, momentum_error_ = 0.0, orthogonality_error_ = 0.0;
+  double range_energy_ = 0.0, range_scale_ = -1.0;  // E and |<p, v>| + |L| at the first range check
 };
 
 }  // namespace varia::host

@@ -269,6 +269,7 @@ class Stepper {
     for (std::size_t i = 0; i < values.size(); ++i)
       if (!std::isfinite(values[i]))
         throw NumericalFailure(fmt::format("a non-finite {} ({})", observer_.columns()[i], values[i]), std::nan(""));
+    if (energy_range_due(k)) observer_.check_energy_range(q.data(), p.data());
     const bool due = k % scene_.output_every == 0 || k == scene_.steps;
     if (csv_ && due)
       csv_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()),
@@ -277,6 +278,17 @@ class Stepper {
       h5_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()), values);
     if (plot_ && due) plot_->record(trajectory_.t(), q, p, values);
   }
+
+  // The energy's sane range (Observer::check_energy_range) is checked for a system without forces
+  // at step 0, the last step, and every row where the energy is observed (it is at hand), else
+  // every kRangeCheckRows-th row: a run that leaves it grows without bound and is caught within a
+  // few rows, at the cost of one energy per kRangeCheckRows rows.
+  bool energy_range_due(long k) {
+    if (!a_.forces.empty()) return false;
+    return scene_.observe.energy || rows_++ % kRangeCheckRows == 0 || k == scene_.steps;
+  }
+  static constexpr long kRangeCheckRows = 16;
+  long rows_ = 0;
 
   const Scene& scene_;
   Assembly& a_;

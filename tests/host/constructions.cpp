@@ -105,9 +105,9 @@ TEST_CASE("predictions follow the theorems' hypotheses (issue #17, defects 1, 2,
   const json shooting_type2{{"construction", "shooting"}, {"form", "type-2"}, {"one_step", {{"type", "rk4"}}},
                             {"quadrature", {{"type", "simpson"}}}};
   const std::vector<Row> rows{
-      // Defect 1: r < s Gauss points determine fewer interior points: order 2 (r - 1), not min(2s, 2r).
-      {"galerkin s = 3, 2 Gauss points", pendulum_with(galerkin_with(3, "gauss-legendre", 2)), 2, true, true, null},
-      {"galerkin s = 4, 3 Gauss points", pendulum_with(galerkin_with(4, "gauss-legendre", 3)), 4, true, true, null},
+      // Defect 1: s Gauss points give min(2s, 2s); Lobatto's s points min(2s, 2s - 2).
+      {"galerkin s = 3, 3 Gauss points", pendulum_with(galerkin_with(3, "gauss-legendre", 3)), 6, true, true, null},
+      {"galerkin s = 4, 4 Lobatto points", pendulum_with(galerkin_with(4, "gauss-lobatto", 4)), 6, true, true, null},
       // Defect 2: the self-adjointness proposition is for the Type I form.
       {"type-2 shooting, rk4 + simpson", pendulum_with(shooting_type2), "any", null, "any", null},
       // Defect 4: Runge-Kutta in the embedding of SO(3) is not canonical.
@@ -132,10 +132,11 @@ TEST_CASE("predictions follow the theorems' hypotheses (issue #17, defects 1, 2,
   }
 }
 
-TEST_CASE("a galerkin rule too weak to determine the interior control points is refused at /method/quadrature "
-          "(defect 1, on 5dea526 it passed validate and verify exited 4)") {
+TEST_CASE("a galerkin rule with fewer weighted nodes than the degree is refused at /method/quadrature (defect 1, "
+          "issue #43 item 2: s = 3 with 2 Gauss points passed validate on 5a2c708 and ran to q = -2.9e132 with exit 0)") {
   for (const json& method : {galerkin_with(2, "midpoint", 0), galerkin_with(3, "trapezoid", 0),
-                             galerkin_with(4, "simpson", 0)}) {
+                             galerkin_with(4, "simpson", 0), galerkin_with(3, "gauss-legendre", 2),
+                             galerkin_with(5, "gauss-legendre", 3), galerkin_with(4, "gauss-lobatto", 3)}) {
     CAPTURE(method.dump());
     std::string message;
     try {

@@ -374,8 +374,33 @@ TEST_CASE("fpu past the stormer-verlet stability limit (h omega = 2.5) blows up:
   MESSAGE("fpu unstable: ", ran.outcome.err, "rows written ", ran.csv.rows.size());
   check_clean_failure(ran);
   CHECK(ran.csv.rows.size() >= 2);
-  // The failure is a non-finite gradient: no residual applies.
-  CHECK(ran.record["failure"]["residual"] == "nan");
+  // The energy leaves its sane range long before a value overflows: its error is the residual.
+  CHECK(contains(ran.outcome.err, "left every sane range"));
+  CHECK(ran.record["failure"]["residual"] > 0);
+  CHECK(ran.record["failure"]["step"] < 40);
+}
+
+// Issue #43 item 2: on 5a2c708 this run exited 0 with q = 8.0e59 at its last step.
+TEST_CASE("a finite run whose energy leaves every sane range ends with exit 4, not exit 0 with garbage") {
+  const json oscillator{{"system", {{"manifold", {{"type", "Rn"}, {"dim", 1}}}, {"lagrangian", {{"type", "harmonic-oscillator"}}}}},
+                        {"method", {{"construction", "galerkin"}, {"degree", 1}, {"quadrature", {{"type", "trapezoid"}}}}},
+                        {"initial", {{"q", {1.0}}, {"p", {0.0}}}},
+                        {"steps", 100}};
+  for (const bool observed : {false, true}) {
+    json past_the_limit = oscillator;  // Stormer-Verlet at h omega = 2.5: the state grows about 4x a step
+    past_the_limit["step"] = 2.5;
+    if (observed) past_the_limit["observe"] = {"energy"};
+    CAPTURE(observed);
+    const Ran ran = run_scene(past_the_limit);
+    check_clean_failure(ran);
+    CHECK(contains(ran.outcome.err, "left every sane range"));
+    // Checked every 16 rows where the energy is not observed, every row where it is.
+    CHECK(ran.record["failure"]["step"] <= (observed ? 2 : 17));
+    CHECK(max_abs(ran.csv.values("q0")) < 1e12);
+  }
+  json inside = oscillator;  // h omega = 1.9: bounded, energy error below the energy
+  inside["step"] = 1.9;
+  check_clean_success(run_scene(inside));
 }
 
 TEST_CASE("fpu just inside the stormer-verlet stability limit (h omega = 1.5) stays bounded") {
