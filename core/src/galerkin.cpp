@@ -71,6 +71,18 @@ std::vector<double> equispaced_control_times(int degree) {
   return d;
 }
 
+std::vector<double> chebyshev_lobatto_control_times(int degree) {
+  if (degree < 1) throw std::invalid_argument("a Galerkin interpolant needs degree >= 1");
+  std::vector<double> d(degree + 1);
+  for (int nu = 0; 2 * nu <= degree; ++nu) {
+    const double half_sine = std::sin(M_PI * nu / (2.0 * degree));  // (1 - cos x) / 2 = sin^2(x / 2)
+    d[nu] = half_sine * half_sine;
+    d[degree - nu] = 1.0 - d[nu];
+  }
+  if (degree % 2 == 0) d[degree / 2] = 0.5;
+  return d;
+}
+
 LagrangeBasis::LagrangeBasis(const std::vector<double>& times, const Quadrature& quadrature)
     : control_times(times) {
   check_control_times(times);

@@ -380,6 +380,24 @@ TEST_CASE("fpu past the stormer-verlet stability limit (h omega = 2.5) blows up:
   CHECK(ran.record["failure"]["step"] < 40);
 }
 
+// Issue #43 item 5: on 5a2c708 (equispaced control times by default) the error at s = 32 was 3e-4.
+TEST_CASE("galerkin of high degree keeps spectral accuracy by default: the pendulum's step at h = 1") {
+  for (const int s : {10, 20, 32}) {
+    const json document{{"system", {{"manifold", {{"type", "Rn"}, {"dim", 1}}}, {"lagrangian", {{"type", "pendulum"}}}}},
+                        {"method", {{"construction", "galerkin"}, {"degree", s},
+                                    {"quadrature", {{"type", "gauss-legendre"}, {"points", s}}}}},
+                        {"initial", {{"q", {1.3}}, {"p", {0.0}}}},
+                        {"step", 1.0},
+                        {"steps", 1}};
+    const Ran ran = run_scene(document);
+    check_clean_success(ran);
+    const double error = std::abs(ran.csv.values("q0").back() - exact_pendulum(document, {1.0}).front());
+    CAPTURE(s);
+    CAPTURE(error);
+    CHECK(error < 1e-14);
+  }
+}
+
 // Issue #43 item 2: on 5a2c708 this run exited 0 with q = 8.0e59 at its last step.
 TEST_CASE("a finite run whose energy leaves every sane range ends with exit 4, not exit 0 with garbage") {
   const json oscillator{{"system", {{"manifold", {{"type", "Rn"}, {"dim", 1}}}, {"lagrangian", {{"type", "harmonic-oscillator"}}}}},

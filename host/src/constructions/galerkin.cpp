@@ -20,7 +20,10 @@ using nlohmann::json;
 
 struct GalerkinOptions : MethodOptions {
   int degree = 0;
-  std::vector<double> control_times;  // s + 1 of them, equispaced unless the scene gives them
+  // s + 1 of them; unless the scene gives them, Chebyshev-Gauss-Lobatto times (galerkin.hpp): the
+  // polynomial space of the equispaced times the contract names, solved in a basis that keeps
+  // round-off at high degree.
+  std::vector<double> control_times;
   bool reduced = false;
 };
 
@@ -64,7 +67,7 @@ class Galerkin final : public Construction {
            {"minimum", 1},
            {"maximum", 32}}},
          {"control_times",
-          {{"description", "s+1 increasing control times from 0 to 1 (default: equispaced)"},
+          {{"description", "s+1 increasing control times from 0 to 1 (default: Chebyshev-Gauss-Lobatto times (1 - cos(pi k/s))/2, the same interpolant space as equispaced times, better conditioned at high degree)"},
            {"type", "array"},
            {"minItems", 2},
            {"items", {{"description", "a control time"}, {"type", "number"}, {"minimum", 0}, {"maximum", 1}}}}},
@@ -83,7 +86,7 @@ class Galerkin final : public Construction {
     options->reduced = method.value("reduced", false);
     options->control_times = method.contains("control_times")
                                  ? method["control_times"].get<std::vector<double>>()
-                                 : equispaced_control_times(options->degree);
+                                 : chebyshev_lobatto_control_times(options->degree);
     check_control_times(options->control_times, options->degree);
     return options;
   }

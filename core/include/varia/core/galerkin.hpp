@@ -62,6 +62,13 @@ Eigen::VectorXd lagrange_basis_at(const std::vector<double>& times, double tau);
 
 // Equispaced control times d_nu = nu / s.
 std::vector<double> equispaced_control_times(int degree);
+// Chebyshev-Gauss-Lobatto control times d_nu = (1 - cos(pi nu / s)) / 2, exactly symmetric
+// (d_{s-nu} = 1 - d_nu). The same polynomial space as any other control times, so the same L_d in
+// exact arithmetic; in floating point their Lagrange basis stays well conditioned at high degree
+// (Lebesgue constant O(log s) against O(2^s / s) for equispaced times), which keeps the spectral
+// accuracy of Hall & Leok's spectral variational integrators: the pendulum's step at h = 1 has an
+// error of about 1e-15 at s = 32, where equispaced times give 3e-4.
+std::vector<double> chebyshev_lobatto_control_times(int degree);
 
 class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHamiltonianMap {
  public:
