@@ -52,15 +52,25 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
   // The local slope over a window of a factor 2 in h, from kept[a] forwards or from kept[c]
   // backwards (on a fine ladder neighbouring slopes differ too little to show a trend).
   auto slope_between = [&](int a, int b) { return std::log(error[a] / error[b]) / std::log(h[a] / h[b]); };
-  auto window_end = [&](std::size_t a) {
+  auto window_end_in = [&](const std::vector<int>& points, std::size_t a) {
     std::size_t b = a + 1;
-    while (b + 1 < kept.size() && h[kept[a]] / h[kept[b]] < kWindow) ++b;
+    while (b + 1 < points.size() && h[points[a]] / h[points[b]] < kWindow) ++b;
     return b;
   };
+  auto window_end = [&](std::size_t a) { return window_end_in(kept, a); };
   auto window_start = [&](std::size_t c) {
     std::size_t a = c - 1;
     while (a > 0 && h[kept[a]] / h[kept[c]] < kWindow) --a;
     return a;
+  };
+  // The local slopes of a list of points (indices, h decreasing), each over a window of a factor 2.
+  auto local_slopes = [&](const std::vector<int>& points) {
+    std::vector<double> local;
+    for (std::size_t a = 0; a + 1 < points.size(); ++a) {
+      const std::size_t b = window_end_in(points, a);
+      if (h[points[a]] / h[points[b]] >= kWindow) local.push_back(slope_between(points[a], points[b]));
+    }
+    return local;
   };
   while (kept.size() >= 3) {
     const std::size_t b = window_end(0);
@@ -93,13 +103,13 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
   // shows, the local slopes creep towards it geometrically (s(h) = p + c h^k on a geometric
   // ladder); when the last four do so consistently (their differences keep one sign and shrink by a
   // steady ratio below 0.9), Aitken's delta-squared takes the limit, and the note says so.
-  std::vector<double> local;
-  for (std::size_t a = 0; a + 1 < kept.size(); ++a) {
-    const std::size_t b = window_end(a);
-    if (h[kept[a]] / h[kept[b]] >= kWindow) local.push_back(slope_between(kept[a], kept[b]));
-  }
-  const std::size_t m = local.size();
-  fit.still_rising = m >= 2 && local[m - 1] > local[m - 2] && (m == 2 || local[m - 2] > local[m - 3]);
+  const std::vector<double> local = local_slopes(kept);
+  if (!local.empty()) fit.slope_spread = *std::max_element(local.begin(), local.end()) - *std::min_element(local.begin(), local.end());
+  std::vector<int> trend = above(error, floor);
+  trend.erase(std::find(trend.begin(), trend.end(), kept.back()) + 1, trend.end());
+  const std::vector<double> trend_local = local_slopes(trend);
+  const std::size_t m = trend_local.size();
+  fit.still_rising = m >= 2 && trend_local[m - 1] > trend_local[m - 2] && (m == 2 || trend_local[m - 2] > trend_local[m - 3]);
   if (local.size() < 4) return fit;
   const std::size_t n = local.size();
   const double d1 = local[n - 3] - local[n - 4], d2 = local[n - 2] - local[n - 3], d3 = local[n - 1] - local[n - 2];

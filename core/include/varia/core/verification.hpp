@@ -38,9 +38,16 @@ struct OrderFit {
   std::vector<std::string> dropped;
   std::vector<double> h, errors;  // all the step sizes and errors, fitted or not
   std::string extrapolated;       // how the slope was extrapolated, when it was
-  // The last local slopes (three, or two when there are only two) still rise and were not extrapolated: the fit may end before its
-  // asymptotic range, and its slope is then a lower bound of the order.
+  // The last local slopes (three, or two when there are only two) still rise and were not
+  // extrapolated: the fit may end before its asymptotic range, and its slope is then a lower bound
+  // of the order. The slopes are those of every point above round-off down to the fit's last one,
+  // the pre-asymptotic points dropped in front included: a short fit at the bottom of a rising
+  // ladder rises with it.
   bool still_rising = false;
+  // The largest minus the smallest local slope over the fitted points: well above the filters'
+  // 0.3, the fit has no asymptotic range (the errors bend between the pre-asymptotic regime and
+  // round-off) and its slope measures no order.
+  double slope_spread = 0.0;
   bool fitted() const { return used >= kMinimumFitPoints; }
 };
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor);
