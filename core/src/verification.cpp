@@ -269,6 +269,19 @@ double round_off_of(DiscreteLagrangian& Ld, Manifold& manifold, const std::vecto
   return worst;
 }
 
+double solver_noise_of(DiscreteLagrangian& Ld, const Manifold& manifold, const std::vector<SamplePair>& pairs, double h,
+                       double tolerance) {
+  Eigen::VectorXd D2(manifold.dim());
+  double worst = 0.0;
+  for (const auto& pair : pairs) {
+    double value = 0.0;
+    Ld.evaluate(pair.q0.data(), pair.q1.data(), h, &value, nullptr, D2.data());
+    const double reach = tolerance * (1.0 + Eigen::Map<const Eigen::VectorXd>(pair.q1.data(), pair.q1.size()).lpNorm<Eigen::Infinity>());
+    worst = std::max(worst, D2.lpNorm<1>() * reach / std::max(std::abs(value), 1e-300));
+  }
+  return worst;
+}
+
 double invariance_residual(DiscreteLagrangian& Ld, Lagrangian& lagrangian,
                            const std::vector<SamplePair>& pairs, double h) {
   double worst = 0.0;

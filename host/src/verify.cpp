@@ -138,8 +138,9 @@ double map_symmetry_residual(Context& x, double h) {
 }
 
 // A residual of L_d at pairs sampled at each step size of `hs` (sample_pairs), against the
-// round-off measured at the same pairs (round_off_of) times kSpread.
-constexpr double kSpread = 100.0;
+// round-off measured at the same pairs (round_off_of) times kSpread, or what the scene's solver
+// tolerance may leave in L_d there (solver_noise_of) times kSolverSpread, the larger.
+constexpr double kSpread = 100.0, kSolverSpread = 10.0;
 
 template <class F>
 DefectScaling ld_defect(Context& x, const char* property, const std::vector<double>& hs, F&& residual) {
@@ -149,7 +150,8 @@ DefectScaling ld_defect(Context& x, const char* property, const std::vector<doub
   for (double h : hs)
     values.push_back(within(property, h, [&] {
       const auto pairs = sample_pairs(*x.a.manifold, x.a.q0.data(), v.data(), h, kPairs);
-      noise = std::max(noise, kSpread * round_off_of(*x.a.discrete_lagrangian, *x.a.manifold, pairs, h));
+      noise = std::max({noise, kSpread * round_off_of(*x.a.discrete_lagrangian, *x.a.manifold, pairs, h),
+                        kSolverSpread * solver_noise_of(*x.a.discrete_lagrangian, *x.a.manifold, pairs, h, x.scene.solver.tolerance)});
       return residual(pairs, h);
     }));
   return defect_scaling(hs, values, noise);
@@ -170,7 +172,7 @@ PropertyCheck self_adjoint(Context& x) {
                                   return self_adjointness_residual(*x.a.discrete_lagrangian, pairs, h);
                                 }),
                       "max |L_d(q0,q1;h) + L_d(q1,q0;-h)| / |L_d| over 5 pairs near the diagonal (noise: 100 times "
-                      "L_d's measured round-off)");
+                      "L_d's measured round-off, or 10 times what the solver's tolerance may leave in L_d)");
 }
 
 PropertyCheck g_invariant(Context& x) {
@@ -185,7 +187,8 @@ PropertyCheck g_invariant(Context& x) {
                                   return invariance_residual(*x.a.discrete_lagrangian, *x.a.lagrangian, pairs, h);
                                 }),
                       fmt::format("max |L_d(g q0, g q1) - L_d(q0, q1)| / |L_d| over 5 pairs, g random in {} (noise: "
-                                  "100 times L_d's measured round-off)",
+                                  "100 times L_d's measured round-off, or 10 times what the solver's tolerance may "
+                                  "leave in L_d)",
                                   x.a.lagrangian->symmetry_group()));
 }
 

@@ -2,17 +2,19 @@
 // L is invariant under rotations, SO(2) or SO(3), acting on q and v alike; its Noether momentum
 // J = <dL/dv, xi q> is the angular momentum q x v (a scalar in the plane).
 //
-// Exact solution for bound orbits (energy < 0) through Lagrange's f and g functions in the
-// difference of eccentric anomalies x = E - E0 (Danby, "Fundamentals of Celestial Mechanics",
-// 2nd ed. 1988, sec. 6.8; Battin, "An Introduction to the Mathematics and Methods of
-// Astrodynamics", 1999, sec. 4.3): with 1/a = 2/r0 - |v0|^2/mu, n = sqrt(mu/a^3),
-// e cos E0 = 1 - r0/a and e sin E0 = (q0.v0)/sqrt(mu a), Kepler's equation
-//   n t = x - e cos E0 sin x + e sin E0 (1 - cos x)
-// is solved by Newton's method, and
-//   q = f q0 + g v0,  v = f' q0 + g' v0,  r = a (1 - e cos E0 cos x + e sin E0 sin x),
-//   f = 1 - a/r0 (1 - cos x),  g = t - (x - sin x)/n,
-//   f' = -sqrt(mu a) sin x/(r r0),  g' = 1 - a/r (1 - cos x).
-// Unbound orbits (energy >= 0) get an error Status, not an answer.
+// Exact solution for every orbit, bound or not, through Lagrange's f and g functions in the
+// universal variable chi (Battin, "An Introduction to the Mathematics and Methods of
+// Astrodynamics", 1999, sec. 4.5; Curtis, "Orbital Mechanics for Engineering Students", sec.
+// 3.7): with alpha = 2/r0 - |v0|^2/mu (1/a; 0 on a parabola, < 0 on a hyperbola), z = alpha chi^2
+// and Stumpff's functions C(z), S(z), the universal Kepler equation
+//   sqrt(mu) t = (q0.v0)/sqrt(mu) chi^2 C + (1 - alpha r0) chi^3 S + r0 chi
+// is solved by Newton's method (its derivative in chi is r > 0), and
+//   q = f q0 + g v0,  v = f' q0 + g' v0,
+//   f = 1 - chi^2 C/r0,  g = t - chi^3 S/sqrt(mu),  f' = sqrt(mu)/(r r0) (alpha chi^3 S - chi),
+//   g' = 1 - chi^2 C/r,  r = chi^2 C + (q0.v0)/sqrt(mu) chi (1 - z S) + r0 (1 - z C),
+// computed in the universal functions U_k (universal() below).
+// One formula for every eccentricity: the eccentric-anomaly form it replaces lost 5 digits near
+// e = 1 (a -> infinity: g = t - (x - sin x)/n cancels) and had no hyperbolic orbits.
 #include <Eigen/Geometry>
 #include <boost/math/constants/constants.hpp>
 #include <boost/math/tools/roots.hpp>
@@ -48,20 +50,33 @@ Eigen::Matrix3d random_rotation(unsigned seed, int dim) {
       .toRotationMatrix();
 }
 
-// The difference form of Kepler's equation, F(x) = x - ec sin x + es (1 - cos x) - M, with
-// F'(x) = r/a > 0 for ec^2 + es^2 = e^2 < 1; its root lies in [M - 2, M + 2].
-double eccentric_anomaly_step(double mean, double ec, double es) {
-  const auto kepler = [&](double x) {
-    return std::pair{x - ec * std::sin(x) + es * (1 - std::cos(x)) - mean,
-                     1 - ec * std::cos(x) + es * std::sin(x)};
-  };
-  constexpr std::uintmax_t limit = 100;
-  std::uintmax_t iterations = limit;
-  const double x = boost::math::tools::newton_raphson_iterate(
-      kepler, mean, mean - 2, mean + 2, std::numeric_limits<double>::digits, iterations);
-  if (iterations >= limit)
-    throw std::runtime_error("kepler: Newton's method on Kepler's equation did not converge");
-  return x;
+// The universal functions U_k(chi) = chi^k c_k(alpha chi^2) (Battin, sec. 4.5), k = 0..3, from
+// sin and cos (sinh and cosh) of y = sqrt(|alpha|) chi directly, so that U0 = cos y and
+// U1 = sin y/sqrt(alpha) keep their own precision where they are small (at pericentre), and from
+// the series of Stumpff's C and S (U2 = chi^2 C, U3 = chi^3 S) for |alpha chi^2| < 1, where the
+// closed forms of U2 and U3 cancel.
+template <class T>
+struct Universal {
+  T U0, U1, U2, U3;
+};
+template <class T>
+Universal<T> universal(T alpha, T chi) {
+  using std::abs, std::cos, std::cosh, std::pow, std::sin, std::sinh, std::sqrt;
+  const T z = alpha * chi * chi;
+  if (abs(z) < 1) {
+    T C = 0, S = 0, term_c = 0.5, term_s = T(1) / 6;  // (-z)^k/(2k+2)!, (-z)^k/(2k+3)!
+    for (int k = 0; k < 40 && (term_c != 0 || term_s != 0); ++k) {
+      C += term_c;
+      S += term_s;
+      term_c *= -z / ((2 * k + 3) * (2 * k + 4));
+      term_s *= -z / ((2 * k + 4) * (2 * k + 5));
+    }
+    const T U2 = chi * chi * C, U3 = chi * chi * chi * S;
+    return {1 - alpha * U2, chi - alpha * U3, U2, U3};
+  }
+  const T root = sqrt(abs(alpha)), y = root * chi;
+  if (alpha > 0) return {cos(y), sin(y) / root, 2 * pow(sin(y / 2), 2) / alpha, (y - sin(y)) / (alpha * root)};
+  return {cosh(y), sinh(y) / root, 2 * pow(sinh(y / 2), 2) / -alpha, (sinh(y) - y) / (-alpha * root)};
 }
 
 // Lagrange's coefficients (f, g, f', g') carrying (q0, v0) along its orbit for a time t, from
@@ -70,23 +85,43 @@ struct LagrangeCoefficients {
   double f, g, fdot, gdot;
 };
 LagrangeCoefficients lagrange_coefficients(double mu, double r0, double w0, double d0, double t) {
-  const double alpha = 2 / r0 - w0 / mu;  // 1/a
-  if (!(alpha > 0))
-    throw std::runtime_error(
-        "kepler: the exact solution covers bound orbits only (energy < 0); this orbit has "
-        "energy " +
-        std::to_string(w0 / 2 - mu / r0));
-  const double a = 1 / alpha, mean_motion = std::sqrt(mu * alpha * alpha * alpha);
-  // The motion has period 2 pi/n: reduce t so that the mean anomaly n t lies in [-pi, pi].
-  const double period = two_pi / mean_motion;
-  const double tr = t - period * std::round(t / period);
-  const double ec = 1 - r0 * alpha, es = d0 * std::sqrt(alpha / mu);
-  const double x = eccentric_anomaly_step(mean_motion * tr, ec, es);
-  const double one_minus_cos = 2 * std::pow(std::sin(x / 2), 2);  // without cancellation
-  const double r = a * (1 - ec * std::cos(x) + es * std::sin(x));
+  const double alpha = 2 / r0 - w0 / mu, root_mu = std::sqrt(mu);
+  // A bound motion has period 2 pi/n: reduce t so that the mean anomaly n t lies in [-pi, pi].
+  if (alpha > 0) {
+    const double period = two_pi / std::sqrt(mu * alpha * alpha * alpha);
+    t -= period * std::round(t / period);
+  }
+  if (t == 0) return {1, 0, 0, 1};
+  const double radial = d0 / root_mu;
+  // Kepler's equation F(chi) = sqrt(mu) t and its derivative r, in the universal functions.
+  const auto equation = [&](double chi) {
+    const Universal u = universal<double>(alpha, chi);
+    return std::pair{radial * u.U2 + u.U3 + r0 * u.U1 - root_mu * t, u.U2 + radial * u.U1 + r0 * u.U0};
+  };
+  // F increases (F' = r > 0) from F(0) = -sqrt(mu) t: bracket the root by doubling.
+  double low = 0, high = 0, step = std::abs(root_mu * t) / r0;
+  if (t > 0)
+    while (equation(high = step).first < 0) step *= 2;
+  else
+    while (equation(low = -step).first > 0) step *= 2;
+  constexpr std::uintmax_t limit = 200;
+  std::uintmax_t iterations = limit;
+  const double chi = boost::math::tools::newton_raphson_iterate(equation, 0.5 * (low + high), low, high,
+                                                                std::numeric_limits<double>::digits, iterations);
+  if (iterations >= limit) throw std::runtime_error("kepler: Newton's method on Kepler's equation did not converge");
+  // One more Newton step and the coefficients in extended precision (long double): the root and r
+  // are sums of terms larger than themselves near pericentre.
+  using X = long double;
+  const X a = alpha, R0 = r0, D = radial;
+  Universal<X> u = universal<X>(a, chi);
+  X r = u.U2 + D * u.U1 + R0 * u.U0;
+  const X refined = chi - (D * u.U2 + u.U3 + R0 * u.U1 - X(root_mu) * X(t)) / r;
+  u = universal<X>(a, refined);
+  r = u.U2 + D * u.U1 + R0 * u.U0;
   if (!(r > 0)) throw std::runtime_error("kepler: the orbit reaches the collision q = 0");
-  return {1 - a / r0 * one_minus_cos, tr - (x - std::sin(x)) / mean_motion,
-          -std::sqrt(mu * a) * std::sin(x) / (r * r0), 1 - a / r * one_minus_cos};
+  // g = t - U3/sqrt(mu), written with Kepler's equation so that nothing cancels against t.
+  return {static_cast<double>(1 - u.U2 / R0), static_cast<double>((R0 * u.U1 + D * u.U2) / X(root_mu)),
+          static_cast<double>(-X(root_mu) * u.U1 / (r * R0)), static_cast<double>(1 - u.U2 / r)};
 }
 
 class Kepler final : public varia::sdk::AutodiffLagrangian<Kepler> {
@@ -108,7 +143,7 @@ class Kepler final : public varia::sdk::AutodiffLagrangian<Kepler> {
     "symmetry": "SO(2) on R^2, SO(3) on R^3",
     "momentum_map": "angular momentum q x v (a scalar on R^2)",
     "exact_solution": true,
-    "exact_solution_domain": "bound orbits (energy < 0); others get an error"
+    "exact_solution_domain": "every orbit: bound, parabolic and hyperbolic (universal variables)"
   })json";
 
   Kepler(const nlohmann::json& parameters, const varia::sdk::Context& context)

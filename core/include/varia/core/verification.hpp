@@ -97,6 +97,13 @@ double self_adjointness_residual(DiscreteLagrangian& Ld, const std::vector<Sampl
 // unit in the last place of each coordinate (near the diagonal L_d magnifies its endpoints'
 // rounding by |q| / |q1 - q0|). The floor of the residuals below and of ld_order's errors.
 double round_off_of(DiscreteLagrangian& Ld, Manifold& manifold, const std::vector<SamplePair>& pairs, double h);
+// What a solve stopped at `tolerance` may leave in L_d at the pairs, relative to |L_d|: a
+// construction whose L_d comes out of an inner solve in which L_d is not stationary (shooting's
+// boundary-value problem q^n(w0) = q1) meets q1 only to tolerance (1 + |q1|) (the Newton solver's
+// stopping rule), which moves L_d by up to |D2 L_d|_1 times that. (Galerkin's L_d is stationary in
+// its interior points: there this bounds a quadratic effect from above.)
+double solver_noise_of(DiscreteLagrangian& Ld, const Manifold& manifold, const std::vector<SamplePair>& pairs, double h,
+                       double tolerance);
 // max |L_d(g q0, g q1) - L_d(q0, q1)| / scale over pseudo-random g of the declared group.
 double invariance_residual(DiscreteLagrangian& Ld, Lagrangian& lagrangian,
                            const std::vector<SamplePair>& pairs, double h);
