@@ -99,6 +99,7 @@ struct Options {
   bool json = false;
   std::string verify_json, cost_out;
   std::vector<double> verify_h;
+  bool verify_explain = false;
   CostOptions cost;
 };
 
@@ -142,8 +143,10 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
       ->type_name("FILE.csv|FILE.h5");
   run->add_option("--summary", o.run_summary, "write the run record JSON here")->type_name("FILE.json");
   run->add_option("--plot", o.run_plot,
-                  "draw q(t) (q0..q2) and the energy error (or p0..p2) into this SVG (gnuplot); a run of more than "
-                  "1000 rows is drawn as the smallest and largest value of each of 1000 stretches of rows")
+                  "draw three panels into this SVG (gnuplot): q(t) (q0..q2; on a Lie group the chart coordinates "
+                  "xi of the start), the phase portrait (p_i against q_i), and |E - E0| on a log scale when the "
+                  "energy is observed (else p0..p2); long runs are drawn in 1000 stretches of rows (their smallest "
+                  "and largest values)")
       ->type_name("FILE.svg");
   run->add_flag("--quiet", o.run.quiet, "no progress line and no human summary");
   run->callback([&] {
@@ -180,6 +183,9 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
                             "Example:\n  varia verify scenes/default.json --json checks.json");
   add_scene(verify, o.scene);
   verify->add_option("--json", o.verify_json, "write the checks as JSON here")->type_name("FILE");
+  verify->add_flag("--explain", o.verify_explain,
+                   "print how each property was predicted and measured (the theorem, the fit, the points dropped "
+                   "and why) after its row; without it the table gives only the reason a property was not measured");
   verify->add_option("--h", o.verify_h, "the step sizes the orders are fitted at, comma-separated: at least 4, no "
                                         "two taking the same number of steps to global_order's final time (20 times "
                                         "the largest step size), none more than 1e8 steps (default: chosen by verify "
@@ -187,7 +193,9 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
       ->delimiter(',')
       ->allow_extra_args(false)
       ->type_name("H,H,..");
-  verify->callback([&] { chosen = [&] { return command_verify(o.common, o.scene, o.verify_json, o.verify_h); }; });
+  verify->callback([&] {
+    chosen = [&] { return command_verify(o.common, o.scene, o.verify_json, o.verify_h, o.verify_explain); };
+  });
 
   auto* cost = subcommand(app, o, "cost",
                           "What accuracy costs in time: error, work and time across step sizes and methods, "

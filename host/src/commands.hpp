@@ -41,6 +41,6 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
 // Prints the table of checks (and writes them as JSON when json_file is not empty); 1 when a
 // property the theorems predict was measured not to hold.
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,
-                   const std::vector<double>& h);
+                   const std::vector<double>& h, bool explain);
 
 }  // namespace varia::host

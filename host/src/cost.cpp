@@ -284,19 +284,23 @@ void write_plot(const std::filesystem::path& file, const std::deque<Method>& met
   Panel work{"work-precision", "seconds (stepping loop)", "global error at the final time", true, true, {}};
   Panel order{"error against step size (dashed: predicted order)", "step size h", "global error at the final time",
               true, true, {}};
+  Panel energy{"energy error against cost", "seconds (stepping loop)", "max |E - E0| over the run", true, true, {}};
   for (const Method& m : methods) {
-    Series by_time{m.name, {}, {}, false}, by_h{m.name, {}, {}, false};
+    Series by_time{m.name, {}, {}, false}, by_h{m.name, {}, {}, false}, energy_by_time{m.name, {}, {}, false};
     for (const Row& r : m.rows) {
       by_time.x.push_back(r.seconds);
       by_time.y.push_back(r.error);
       by_h.x.push_back(r.h);
       by_h.y.push_back(r.error);
+      energy_by_time.x.push_back(r.seconds);
+      energy_by_time.y.push_back(r.energy_error);
     }
     work.series.push_back(std::move(by_time));
     order.series.push_back(std::move(by_h));
+    energy.series.push_back(std::move(energy_by_time));
   }
   for (const Method& m : methods) order.series.push_back(slope_line(m));
-  write_svg(file, {work, order});
+  write_svg(file, {work, order, energy});
 }
 
 // The method's rows; its name, file and reference (text from the scenes) shown printable.

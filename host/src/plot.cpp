@@ -34,7 +34,7 @@ std::string label(const std::string& text) {
   for (std::size_t i = 0; i < text.size() && i < kMaxLength; ++i) {
     const char c = text[i];
     const bool safe = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') ||
-                      std::strchr(" .,:;()+-=*/^_[]", c) != nullptr;
+                      std::strchr(" .,:;()+-=*/^_[]|", c) != nullptr;
     out += safe && c != '\0' ? c : '_';
   }
   return out + "'";
@@ -58,6 +58,14 @@ std::string data_blocks(const std::vector<Panel>& panels) {
   return script;
 }
 
+// Markers only where they can be told apart: a curve of many points is a line (10^4 markers are a
+// solid block).
+constexpr std::size_t kMarkedPoints = 60;
+const char* style(const Series& series) {
+  if (series.dashed) return "lines dashtype 2 lw 1.5";
+  return series.x.size() <= kMarkedPoints ? "linespoints pt 7 ps 0.5 lw 1.5" : "lines lw 1.2";
+}
+
 std::string panel_commands(const Panel& panel, std::size_t index) {
   std::string script = fmt::format("set title {} noenhanced\nset xlabel {} noenhanced\nset ylabel {} noenhanced\n",
                                    label(panel.title), label(panel.xlabel), label(panel.ylabel));
@@ -66,8 +74,7 @@ std::string panel_commands(const Panel& panel, std::size_t index) {
   script += "plot ";
   for (std::size_t s = 0; s < panel.series.size(); ++s) {
     const Series& series = panel.series[s];
-    script += fmt::format("{}$d{}_{} using 1:2 with {} title {} noenhanced", s ? ", " : "", index, s,
-                          series.dashed ? "lines dashtype 2 lw 1.5" : "linespoints pt 7 ps 0.5 lw 1.5",
+    script += fmt::format("{}$d{}_{} using 1:2 with {} title {} noenhanced", s ? ", " : "", index, s, style(series),
                           label(series.title));
   }
   return script + "\n";
@@ -129,8 +136,8 @@ void write_svg(const std::filesystem::path& file, const std::vector<Panel>& pane
   std::string script = data_blocks(panels);
   script += fmt::format(
       "set terminal svg size {},{} dynamic enhanced font 'sans,11' background rgb 'white'\n"
-      "set grid\nset key top right box opaque\nset multiplot layout 1,{}\n",
-      520 * panels.size(), 420, panels.size());
+      "set grid\nset key below box\nset multiplot layout 1,{}\n",
+      520 * panels.size(), 460, panels.size());
   for (std::size_t p = 0; p < panels.size(); ++p) script += panel_commands(panels[p], p);
   script += "unset multiplot\n";
   write_output(file, run_gnuplot(script), "the plot");

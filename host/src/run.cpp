@@ -146,39 +146,71 @@ class DecimatedCurve {
   std::vector<double> t_, y_;
 };
 
-// The written rows as `run --plot` draws them: q(t) (up to three coordinates) beside the energy
-// error E - E0 when energy is observed, else p(t), each a DecimatedCurve of `rows` rows in at most
-// kPlotStretches stretches.
+// `run --plot`'s phase portrait keeps at most this many rows (every k-th).
+constexpr long kPhasePoints = 4000;
+
+// The written rows as `run --plot` draws them, in three panels: the configuration against t, the
+// phase portrait, and |E - E0| on a log scale when the energy is observed (else p against t).
+// The configuration is q's first three numbers on a vector space; on a Lie group, whose point is
+// matrix entries, the natural-chart coordinates xi = log(q(0)^{-1} q) of the start. The phase
+// portrait draws p_i against coordinate i (up to three pairs) at every k-th row. Whatever the
+// number of rows, every curve is bounded (DecimatedCurve, kPhasePoints).
 class PlotRecorder {
  public:
-  PlotRecorder(bool energy, long rows)
-      : energy_(energy), per_stretch_((rows + kPlotStretches - 1) / kPlotStretches) {}
+  PlotRecorder(Manifold& manifold, bool energy, long rows)
+      : manifold_(manifold),
+        energy_(energy),
+        per_stretch_((rows + kPlotStretches - 1) / kPlotStretches),
+        phase_every_((rows + kPhasePoints - 1) / kPhasePoints),
+        coordinates_(manifold.is_vector_space() ? manifold.point_size() : manifold.dim()) {}
+
   void record(double t, const Eigen::VectorXd& q, const Eigen::VectorXd& p, const std::vector<double>& values) {
-    if (coordinates_.empty()) {
-      coordinates_.assign(std::min<Eigen::Index>(q.size(), 3), DecimatedCurve(per_stretch_));
-      right_.assign(energy_ ? 1 : std::min<Eigen::Index>(p.size(), 3), DecimatedCurve(per_stretch_));
-      if (energy_) initial_energy_ = values[0];
-    }
-    for (std::size_t i = 0; i < coordinates_.size(); ++i) coordinates_[i].add(t, q[static_cast<Eigen::Index>(i)]);
+    if (configuration_.empty()) start(q, values);
+    if (manifold_.is_vector_space()) coordinates_ = q;
+    else check(manifold_, manifold_.local(start_.data(), q.data(), coordinates_.data()), "local");
+    for (std::size_t i = 0; i < configuration_.size(); ++i) configuration_[i].add(t, coordinates_[index(i)]);
     for (std::size_t i = 0; i < right_.size(); ++i)
-      right_[i].add(t, energy_ ? values[0] - initial_energy_ : p[static_cast<Eigen::Index>(i)]);
+      right_[i].add(t, energy_ ? std::abs(values[0] - initial_energy_) : p[index(i)]);
+    if (rows_++ % phase_every_ == 0)
+      for (std::size_t i = 0; i < phase_.size(); ++i) {
+        phase_[i].x.push_back(coordinates_[index(i)]);
+        phase_[i].y.push_back(p[index(i)]);
+      }
   }
+
   void write(const std::filesystem::path& file) {
-    std::vector<Series> coordinates, right;
-    for (std::size_t i = 0; i < coordinates_.size(); ++i)
-      coordinates.push_back(coordinates_[i].series(fmt::format("q{}", i)));
+    const char* q = manifold_.is_vector_space() ? "q" : "xi";
+    std::vector<Series> configuration, right;
+    for (std::size_t i = 0; i < configuration_.size(); ++i)
+      configuration.push_back(configuration_[i].series(fmt::format("{}{}", q, i)));
     for (std::size_t i = 0; i < right_.size(); ++i)
-      right.push_back(right_[i].series(energy_ ? "E - E0" : fmt::format("p{}", i)));
-    write_svg(file, {Panel{"configuration", "t", "q", false, false, coordinates},
-                     Panel{energy_ ? "energy error" : "momentum", "t", energy_ ? "E(t) - E(0)" : "p", false, false,
+      right.push_back(right_[i].series(energy_ ? "|E - E0|" : fmt::format("p{}", i)));
+    write_svg(file, {Panel{"configuration", "t", manifold_.is_vector_space() ? "q" : "xi = log(q(0)^-1 q)", false,
+                           false, configuration},
+                     Panel{"phase portrait", manifold_.is_vector_space() ? "q_i" : "xi_i", "p_i", false, false, phase_},
+                     Panel{energy_ ? "energy error" : "momentum", "t", energy_ ? "|E(t) - E(0)|" : "p", false, energy_,
                            right}});
   }
 
  private:
+  static Eigen::Index index(std::size_t i) { return static_cast<Eigen::Index>(i); }
+  void start(const Eigen::VectorXd& q, const std::vector<double>& values) {
+    start_ = q;
+    const auto curves = std::min<Eigen::Index>(coordinates_.size(), 3);
+    configuration_.assign(curves, DecimatedCurve(per_stretch_));
+    right_.assign(energy_ ? 1 : curves, DecimatedCurve(per_stretch_));
+    for (Eigen::Index i = 0; i < curves; ++i)
+      phase_.push_back(Series{fmt::format("({}{}, p{})", manifold_.is_vector_space() ? "q" : "xi", i, i), {}, {}, false});
+    if (energy_) initial_energy_ = values[0];
+  }
+
+  Manifold& manifold_;
   bool energy_;
-  long per_stretch_;
+  long per_stretch_, phase_every_, rows_ = 0;
   double initial_energy_ = 0.0;
-  std::vector<DecimatedCurve> coordinates_, right_;
+  Eigen::VectorXd start_, coordinates_;
+  std::vector<DecimatedCurve> configuration_, right_;
+  std::vector<Series> phase_;
 };
 
 // The rows a run writes (spec "output.every"): step 0, every k-th step, and the last step.
@@ -199,7 +231,7 @@ class Stepper {
       h5_ = std::make_unique<Hdf5Writer>(*options.out, scene.text);
     else if (options.out)
       csv_ = std::make_unique<CsvWriter>(*options.out);
-    if (options.plot) plot_ = std::make_unique<PlotRecorder>(scene.observe.energy, written_rows(scene));
+    if (options.plot) plot_ = std::make_unique<PlotRecorder>(*a.manifold, scene.observe.energy, written_rows(scene));
   }
 
   PlotRecorder* plot() { return plot_.get(); }

@@ -610,15 +610,30 @@ json checks_json(const std::vector<PropertyCheck>& checks) {
   return {{"checks", list}};
 }
 
-std::string checks_table(const std::vector<PropertyCheck>& checks) {
+// The reason a property was not measured, from its note ("...; not measured: <reason>"), cut to
+// a table cell; empty where it was measured.
+std::string short_reason(const PropertyCheck& c) {
+  constexpr std::size_t kShortReason = 72;
+  if (!c.unmeasured()) return "";
+  const auto at = c.note.rfind("not measured: ");
+  std::string reason = at == std::string::npos ? c.note : c.note.substr(at + 14);
+  if (reason.size() > kShortReason) reason = reason.substr(0, kShortReason - 3) + "...";
+  return reason;
+}
+
+std::string checks_table(const std::vector<PropertyCheck>& checks, bool explain) {
   std::string out = fmt::format("{:<20} {:>9} {:>11} {:>10}  {:<8} {}\n", "property", "predicted", "measured",
-                                "tolerance", "holds", "how");
+                                "tolerance", "holds", explain ? "how" : "why not measured");
   for (const auto& c : checks) {
     const std::string measured = c.measured ? fmt::format("{:.3g}", *c.measured) : "-";
     const std::string holds = c.unmeasured() ? "NOT MEASURED (!)" : !c.holds ? "-" : c.failed() ? "NO (!)" : *c.holds ? "yes" : "no";
-    out += fmt::format("{:<20} {:>9} {:>11} {:>10.2g}  {:<8} {}\n", c.name,
-                       c.predicted.is_null() ? "-" : c.predicted.dump(), measured, c.tolerance, holds, c.note);
+    std::string row = fmt::format("{:<20} {:>9} {:>11} {:>10.2g}  {:<8} {}", c.name,
+                                  c.predicted.is_null() ? "-" : c.predicted.dump(), measured, c.tolerance, holds,
+                                  explain ? "" : short_reason(c));
+    out += row.erase(row.find_last_not_of(' ') + 1) + "\n";
+    if (explain) out += fmt::format("  {}\n", c.note);
   }
+  if (!explain) out += "(how each property was predicted and measured: --explain, or --json FILE)\n";
   return out;
 }
 

@@ -41,6 +41,9 @@ void check_fit_steps(const Scene& scene, const std::vector<double>& h);
 std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& assembly, Registry& registry,
                                         const std::vector<double>& h = {});
 nlohmann::json checks_json(const std::vector<PropertyCheck>& checks);
-std::string checks_table(const std::vector<PropertyCheck>& checks);
+// The table `verify` prints: property, predicted, measured, tolerance, holds, and why a property
+// was not measured (at most kShortReason characters); with `explain`, each row's whole note (the
+// theorem, the measurement, the fit and its dropped points) on the lines after it.
+std::string checks_table(const std::vector<PropertyCheck>& checks, bool explain);
 
 }  // namespace varia::host

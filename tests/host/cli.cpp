@@ -3,6 +3,7 @@
 // bad_scenes.cpp, the bad plugins in fault_plugins.cpp).
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -177,13 +178,24 @@ TEST_CASE("plugins flags a type that two files provide, naming both, in the tabl
 }
 
 // The points gnuplot drew (each a use of the point symbol of `pt 7`, the legend's samples included).
-long drawn_points(const std::string& svg) {
-  long count = 0;
-  for (auto at = svg.find("'#gpPt6'"); at != std::string::npos; at = svg.find("'#gpPt6'", at + 1)) ++count;
-  return count;
+// The vertices (M and L commands) of each curve gnuplot drew (a stroked path of 10 or more), in
+// the order drawn; each path starts with its legend's sample line (2 vertices).
+std::vector<long> curve_vertices(const std::string& svg) {
+  std::vector<long> curves;
+  const std::string start = "<path stroke='rgb";
+  for (auto at = svg.find(start); at != std::string::npos; at = svg.find(start, at + 1)) {
+    const auto d = svg.find("d='", at), end = svg.find('\'', d + 3);
+    const std::string path = svg.substr(d + 3, end - d - 3);
+    const long vertices = std::count(path.begin(), path.end(), 'M') + std::count(path.begin(), path.end(), 'L');
+    if (vertices >= 10) curves.push_back(vertices);
+  }
+  return curves;
 }
 
-TEST_CASE("run --plot draws a long run as the least and largest value of 1000 stretches of rows per curve") {
+// Issue #43 item 14: on 5a2c708 the plot had two panels (q(t), E - E0 on a linear scale), a marker
+// at every point (1000s of them: a solid block) and the legend inside the data.
+TEST_CASE("run --plot draws q(t), the phase portrait and |E - E0| on a log scale, each curve bounded whatever the "
+          "number of rows") {
   TempDir dir;
   json scene = json::parse(read_file(kSourceDir / "scenes" / "oscillator-galerkin.json"));
   scene.erase("t_end");
@@ -195,11 +207,33 @@ TEST_CASE("run --plot draws a long run as the least and largest value of 1000 st
       run_varia("run '" + (dir / "s.json").string() + "' --quiet --plot '" + (dir / "p.svg").string() + "'");
   CAPTURE(outcome.err);
   REQUIRE(outcome.code == 0);
-  // Two curves (q0, E - E0), each of at most 1000 stretches (of 101 rows) drawn as their two
-  // extremes, or one where they are the same row; q0 moves in every stretch.
-  const long points = drawn_points(read_file(dir / "p.svg"));
-  CHECK(points >= 2 * 1000 + 2);
-  CHECK(points <= 2 * 2 * 1000 + 2);
+  // q0 and |E - E0| each in at most 1000 stretches (of 101 rows) drawn as their two extremes (or
+  // one where they are the same row; q0 moves in every stretch), the phase portrait every 26th row
+  // (at most 4000), lines without markers, the legend below the panels.
+  const std::string svg = read_file(dir / "p.svg");
+  const auto curves = curve_vertices(svg);
+  REQUIRE(curves.size() == 3);
+  CHECK(curves[0] >= 1000 + 2);
+  CHECK(curves[0] <= 2 * 1000 + 2 + 2);
+  CHECK(curves[1] >= 3000);
+  CHECK(curves[1] <= 4000 + 2 + 2);
+  CHECK(curves[2] <= 2 * 1000 + 2 + 2);
+  for (const char* title : {"<title>q0</title>", "<title>(q0, p0)</title>", "<title>|E - E0|</title>",
+                            "phase portrait"})
+    CHECK(contains(svg, title));
+  CHECK_FALSE(contains(svg, "'#gpPt6'"));  // no markers on a long curve
+}
+
+TEST_CASE("run --plot on a Lie group draws the natural-chart coordinates of the start, not matrix entries") {
+  TempDir dir;
+  const auto outcome = run_varia("run '" + (kSourceDir / "scenes" / "paper" / "rigid-body-lgvi.json").string() +
+                                 "' --quiet --plot '" + (dir / "p.svg").string() + "'");
+  CAPTURE(outcome.err);
+  REQUIRE(outcome.code == 0);
+  const std::string svg = read_file(dir / "p.svg");
+  for (const char* title : {"<title>xi0</title>", "<title>xi2</title>", "<title>(xi1, p1)</title>"})
+    CHECK(contains(svg, title));
+  CHECK_FALSE(contains(svg, "<title>q0</title>"));
 }
 
 TEST_CASE("a solve that does not converge exits 4, the rows written stay whole, the record names the failure") {

@@ -241,6 +241,25 @@ TEST_CASE("kepler references: the solver's tolerance is in the noise floor, and 
   CHECK(open_orbit["global_order"].note.find("against the exact solution") != std::string::npos);
 }
 
+// Issue #43 item 14: on 5a2c708 every row carried its whole note, 300-600 characters.
+TEST_CASE("verify prints a short table, and the derivation of each row with --explain") {
+  const std::string scene = (varia::test::kSourceDir / "scenes" / "default.json").string();
+  const auto table = varia::test::run_varia("verify '" + scene + "'");
+  REQUIRE(table.code == 0);
+  std::size_t widest = 0, rows = 0;
+  for (std::size_t start = 0, end; (end = table.out.find('\n', start)) != std::string::npos; start = end + 1) {
+    widest = std::max(widest, end - start);
+    ++rows;
+  }
+  CHECK(rows == 9);  // the header, seven properties, the pointer to --explain
+  CHECK(widest <= 120);
+  CHECK(varia::test::contains(table.out, "--explain"));
+  const auto explained = varia::test::run_varia("verify '" + scene + "' --explain");
+  REQUIRE(explained.code == 0);
+  CHECK(varia::test::contains(explained.out, "order min(2s, quadrature order)"));
+  CHECK(varia::test::contains(explained.out, "points fitted"));
+}
+
 TEST_CASE("shooting with crouch-grossman on SO(3) (scenes/paper/rigid-body-shooting-cg.json): predicted and "
           "measured not self-adjoint, G-invariant, momentum-conserving, order 2") {
   Verified cg(json::parse(varia::test::read_file(varia::test::kSourceDir / "scenes/paper/rigid-body-shooting-cg.json")));
