@@ -136,20 +136,31 @@ std::string distrust_one(const fs::path& path, bool directory, bool trusted) {
                      status.st_mode & 07777, kTrustedVariable);
 }
 
+// Why `directory` or one above it may not be trusted, or "" when none may.
+std::string distrust_directories(fs::path directory, const std::vector<fs::path>& trusted) {
+  for (;; directory = directory.parent_path()) {
+    if (std::string why = distrust_one(directory, true, is_trusted(directory, trusted)); !why.empty())
+      return fmt::format("its directory {} is {}", directory.string(), why);
+    if (directory == directory.parent_path()) return "";
+  }
+}
+
 // Why a plugin file may not be trusted, or "" when it may (as sshd's StrictModes and sudo check):
 // whoever can write the file, or any directory above it, could make the host run their code. The
-// file is followed through symbolic links to the file itself.
+// file is followed through symbolic links to the file itself, and the directories of the path as
+// given are checked too: a link in a directory another user can write could be pointed elsewhere
+// between this check and the load (which opens the canonical path, open_library).
 std::string distrust(const fs::path& file, const std::vector<fs::path>& trusted) {
   std::error_code ec;
   const fs::path real = fs::canonical(file, ec);
   if (ec) return fmt::format("cannot be inspected: {}", ec.message());
   if (std::string why = distrust_one(real, false, is_trusted(real, trusted)); !why.empty())
     return real == file ? why : fmt::format("{} (where it links to) is {}", real.string(), why);
-  for (fs::path directory = real.parent_path();; directory = directory.parent_path()) {
-    if (std::string why = distrust_one(directory, true, is_trusted(directory, trusted)); !why.empty())
-      return fmt::format("its directory {} is {}", directory.string(), why);
-    if (directory == directory.parent_path()) return "";
-  }
+  if (std::string why = distrust_directories(real.parent_path(), trusted); !why.empty()) return why;
+  // Lexically: each directory that holds a link on the way is checked, not only where links lead.
+  const fs::path given = fs::absolute(file, ec).lexically_normal().parent_path();
+  if (ec) return fmt::format("cannot be inspected: {}", ec.message());
+  return distrust_directories(given, trusted);
 }
 
 std::string dlopen_error(const fs::path& file) {
@@ -202,10 +213,15 @@ struct Registry::Loaded {
 
 namespace {
 
+// Opens the file at its canonical path, the one whose directories distrust() checked: a link on
+// the path as given is not followed again.
 std::shared_ptr<boost::dll::shared_library> open_library(const fs::path& file) {
   auto library = std::make_shared<boost::dll::shared_library>();
   boost::dll::fs::error_code ec;
-  library->load(file, ec, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local);
+  std::error_code canonical_ec;
+  const fs::path real = fs::canonical(file, canonical_ec);
+  if (canonical_ec) throw Refused{"cannot be opened: " + canonical_ec.message()};
+  library->load(real, ec, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local);
   if (ec) throw Refused{"not a loadable shared library: " + dlopen_error(file)};
   return library;
 }
@@ -248,6 +264,11 @@ PluginRecord read_info(const boost::dll::shared_library& library, const fs::path
 std::shared_ptr<Registry::Loaded> Registry::load(const fs::path& file, const SymbolScan& scan) {
   try {
     if (!scan.parsed) throw Refused{"not a shared library (its format cannot be read)"};
+    // Its type is read from the exported markers without running it; a file whose symbols cannot
+    // be read (no section headers) would have to run its code to tell, so it is not loaded at all.
+    if (!scan.has_symbol_table)
+      throw Refused{"its dynamic symbol table cannot be read (no section headers), so its type cannot be read "
+                    "without running its code, and it is not loaded"};
     auto loaded = std::make_shared<Loaded>();
     note_plugin_file(file);  // before its code runs: a crash in its initializers is named too
     loaded->library = open_library(file);
@@ -257,7 +278,7 @@ std::shared_ptr<Registry::Loaded> Registry::load(const fs::path& file, const Sym
     const bool declared = std::any_of(scan.markers.begin(), scan.markers.end(), [&](const Marker& m) {
       return m.kind == record.kind && m.type == record.type;
     });
-    if (scan.has_symbol_table && !declared)
+    if (!declared)
       throw Refused{fmt::format("varia_info says {} '{}' but no matching varia_type_ marker is exported",
                                 record.kind, record.type)};
     if (!loaded->library->has("varia_create")) throw Refused{"no varia_create factory"};
@@ -375,19 +396,10 @@ std::vector<fs::path> Registry::files_declaring(const std::string& kind, const s
   std::vector<fs::path> files;
   for (const auto& file : candidates()) {
     const SymbolScan& s = scan(file);
-    if (!s.parsed) continue;
     const bool declares = std::any_of(s.markers.begin(), s.markers.end(), [&](const Marker& m) {
       return m.kind == kind && m.type == type;
     });
-    if (declares) {
-      files.push_back(file);
-    } else if (!s.has_symbol_table) {  // stripped: only its metadata can tell
-      try {
-        const auto loaded = load(file, s);
-        if (loaded->record.kind == kind && loaded->record.type == type) files.push_back(file);
-      } catch (const PluginLoadError&) {
-      }
-    }
+    if (declares) files.push_back(file);
   }
   return files;
 }

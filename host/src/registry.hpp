@@ -51,7 +51,7 @@ struct Marker {
 // an ELF64 file (kept by `strip`), else what boost::dll reads.
 struct SymbolScan {
   bool parsed = false;            // false: not a binary that can be read
-  bool has_symbol_table = false;  // false: no symbols at all; find() must load it to learn its type
+  bool has_symbol_table = false;  // false: no symbols can be read; the file is never loaded (load())
   std::vector<Marker> markers;
 };
 

@@ -7,6 +7,7 @@
 
 #include <unistd.h>
 
+#include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
 
@@ -213,6 +214,15 @@ TEST_CASE("plugins behind a link, under a writable parent or owned by another us
          fs::copy_file(kFaultPluginDir / "fault_returns_nan.so", plugin_dir / "fault_returns_nan.so");
          fs::permissions(top.path(), fs::perms::all);
        }},
+      // Issue #43 item 10: on 5a2c708 the link was trusted by where it led, and loaded by its name.
+      {"a link in a directory writable by all to a plugin in a trusted one", "plugins is writable by group or others",
+       false,
+       [](const TempDir& top, const fs::path& plugin_dir) {
+         fs::create_directory(top / "safe");
+         fs::copy_file(kFaultPluginDir / "fault_returns_nan.so", top / "safe" / "real.so");
+         fs::create_symlink(top / "safe" / "real.so", plugin_dir / "fault_returns_nan.so");
+         fs::permissions(plugin_dir, fs::perms::all);
+       }},
       {"a file owned by another user", "owned by another user", true,
        [](const TempDir&, const fs::path& plugin_dir) {
          fs::copy_file(kFaultPluginDir / "fault_returns_nan.so", plugin_dir / "fault_returns_nan.so");
@@ -236,17 +246,40 @@ TEST_CASE("plugins behind a link, under a writable parent or owned by another us
   }
 }
 
-TEST_CASE("a plugin whose type no scene names is never loaded, stripped or not") {
-  for (const bool stripped : {false, true}) {
-    CAPTURE(stripped);
+// The ELF header's section header table removed (e_shoff, e_shnum, e_shstrndx zeroed): the
+// dynamic loader needs none, so the file still loads, but no symbol can be read from it.
+void remove_section_headers(const fs::path& file) {
+  std::fstream elf(file, std::ios::in | std::ios::out | std::ios::binary);
+  const char zeros[8] = {};
+  elf.seekp(40);  // e_shoff
+  elf.write(zeros, 8);
+  elf.seekp(60);  // e_shnum, e_shstrndx
+  elf.write(zeros, 4);
+  REQUIRE(elf.good());
+}
+
+// Issue #43 item 10: on 5a2c708 the file without section headers was loaded (its constructors run,
+// here abort) by every run, whatever the scene named.
+TEST_CASE("a plugin whose type no scene names is never loaded: stripped, or without section headers") {
+  for (const char* form : {"as built", "stripped", "without section headers"}) {
+    CAPTURE(form);
     TempDir dir;
     const auto plugin = dir / "fault_aborts_on_load.so";
     fs::copy_file(fs::path(VARIA_ABORTING_PLUGIN_DIR) / "fault_aborts_on_load.so", plugin);
-    if (stripped) REQUIRE(std::system(("strip --strip-all '" + plugin.string() + "'").c_str()) == 0);
+    if (std::string(form) == "stripped")
+      REQUIRE(std::system(("strip --strip-all '" + plugin.string() + "'").c_str()) == 0);
+    if (std::string(form) == "without section headers") remove_section_headers(plugin);
     const auto outcome = run_varia("run scenes/default.json --quiet --plugin-path '" + dir.path().string() + "'");
     CAPTURE(outcome.err);
     CHECK(outcome.code == 0);
   }
+  TempDir dir;  // varia plugins names it, unloaded
+  fs::copy_file(fs::path(VARIA_ABORTING_PLUGIN_DIR) / "fault_aborts_on_load.so", dir / "fault_aborts_on_load.so");
+  remove_section_headers(dir / "fault_aborts_on_load.so");
+  const auto listing = run_varia("plugins --plugin-path '" + dir.path().string() + "'");
+  CAPTURE(listing.err);
+  CHECK(listing.code == 0);
+  CHECK(contains(listing.out, "no section headers"));
 }
 
 // The lines of stderr that varia wrote (a shell that ran it may add its own, e.g. "Aborted").
