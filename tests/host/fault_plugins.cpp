@@ -88,6 +88,9 @@ TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) namin
       {"fault-abi", 3, "fault_wrong_abi.so", "ABI version"},
       {"fault-no-info", 3, "fault_no_metadata.so", "missing metadata (no varia_info)"},
       {"fault-bad-schema", 3, "fault_bad_schema.so", "unusable parameter_schema"},
+      // Issue 43, item 10: the pattern was written through, and varia died of SIGSEGV (exit 139).
+      {"fault-bad-pattern", 3, "fault_bad_hessian_pattern.so",
+       "sparse Hessian pattern names entry 3 at (row 268435456, column 268435456), outside its 2 x 2 Hessian"},
   };
   for (const auto& c : cases) {
     CAPTURE(c.lagrangian);
