@@ -59,6 +59,8 @@ TEST_CASE("plugins lists the good fault plugins and refuses each bad file with i
       {"fault_no_metadata.so", "missing metadata (no varia_info)"},
       {"fault_bad_schema.so", "unusable parameter_schema in varia_info: "},
       {"fault_bad_properties.so", "its properties declare \"symplectic\": \"yes\", expected true or false"},
+      // Issue 43, item 9: listing it overflowed the stack (exit 139).
+      {"fault_deep_schema.so", "malformed parameter_schema in varia_info: /not/not/not/not/not/not/not/not"},
   };
   const auto table = run_varia("plugins " + faults.flag());
   CAPTURE(table.out);
