@@ -109,6 +109,25 @@ TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) namin
   }
 }
 
+// Issue 43, item 10: the composite read its coordinates through the pattern unchecked.
+TEST_CASE("an effect whose Hessian pattern lies outside its coordinates is a plugin fault naming its file, exit 3") {
+  const FaultDirectory faults;
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
+  scene["system"]["lagrangian"] = {{"type", "composite"},
+                                   {"space_dim", 1},
+                                   {"masses", {1.0}},
+                                   {"terms", {{{"type", "fault-bad-effect-pattern"}}}}};
+  scene.erase("observe");
+  const auto file = faults.dir / "bad_effect.json";
+  write_file(file, scene.dump());
+  const auto outcome = run_varia("validate '" + file.string() + "' " + faults.flag());
+  CAPTURE(outcome.err);
+  CHECK(outcome.code == 3);
+  check_one_error_line(outcome, (faults.dir / "fault_bad_effect_pattern.so").string());
+  CHECK(contains(outcome.err, "terms/0: the effect's Hessian pattern names entry 1 at (row 268435456, column 0), "
+                              "outside its 1 coordinates"));
+}
+
 TEST_CASE("a plugin fault in the middle of a run leaves a run record that notes it") {
   const FaultDirectory faults;
   const auto scene = scene_with_lagrangian(faults.dir, "fault-evaluate");
