@@ -42,7 +42,17 @@ CompositeLagrangian::Term CompositeLagrangian::bind(std::shared_ptr<Effect> effe
       throw std::invalid_argument(where + "the effect names a coordinate outside q");
   const int *rows = nullptr, *cols = nullptr;
   const int entries = effect->hessian_pattern(&rows, &cols);
-  for (int e = 0; e < entries; ++e) term.slots.push_back(pattern_.slot(term.indices[rows[e]], term.indices[cols[e]]));
+  if (entries > 0 && (rows == nullptr || cols == nullptr))
+    throw PluginFault(where + "the effect declares a Hessian pattern without its rows and columns", effect->origin());
+  for (int e = 0; e < entries; ++e) {
+    // The pattern indexes the effect's own k coordinates; one outside them is the plugin's fault.
+    if (rows[e] < 0 || rows[e] >= k || cols[e] < 0 || cols[e] >= k)
+      throw PluginFault(where + "the effect's Hessian pattern names entry " + std::to_string(e) + " at (row " +
+                            std::to_string(rows[e]) + ", column " + std::to_string(cols[e]) + "), outside its " +
+                            std::to_string(k) + " coordinates",
+                        effect->origin());
+    term.slots.push_back(pattern_.slot(term.indices[rows[e]], term.indices[cols[e]]));
+  }
   term.at_doubles.x.resize(k);
   term.at_doubles.gradient.resize(k);
   term.hessian.resize(entries);

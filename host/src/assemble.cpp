@@ -130,6 +130,24 @@ void check_momentum_size(const Lagrangian& lagrangian, int dim) {
                       lagrangian.origin());
 }
 
+void check_hessian_pattern(const Lagrangian& lagrangian) {
+  const int *rows = nullptr, *cols = nullptr;
+  const int entries = lagrangian.hessian_pattern(&rows, &cols);
+  if (entries <= 0) return;
+  const int size = lagrangian.position_size() + lagrangian.velocity_size();
+  if (rows == nullptr || cols == nullptr)
+    throw PluginFault(fmt::format("the Lagrangian declares a sparse Hessian of {} entries without their rows and "
+                                  "columns",
+                                  entries),
+                      lagrangian.origin());
+  for (int e = 0; e < entries; ++e)
+    if (rows[e] < 0 || rows[e] >= size || cols[e] < 0 || cols[e] >= size)
+      throw PluginFault(fmt::format("the Lagrangian's sparse Hessian pattern names entry {} at (row {}, column {}), "
+                                    "outside its {} x {} Hessian over (q, v)",
+                                    e, rows[e], cols[e], size, size),
+                        lagrangian.origin());
+}
+
 bool has_exact_solution(const Assembly& a) { return a.forces.empty() && a.lagrangian->has_exact_solution(); }
 
 Assembly assemble(const Scene& scene, Registry& registry) {
@@ -141,6 +159,7 @@ Assembly assemble(const Scene& scene, Registry& registry) {
   a.lagrangian = lagrangian(scene, registry, *a.manifold);
   check_lagrangian_fits(scene, *a.lagrangian, *a.manifold);
   check_momentum_size(*a.lagrangian, a.manifold->dim());
+  check_hessian_pattern(*a.lagrangian);
   check_dense_size(scene, *a.lagrangian);
   check_observables(scene, *a.lagrangian, *a.manifold);
   create_forces(scene, registry, a);

@@ -46,6 +46,11 @@ bool has_exact_solution(const Assembly& assembly);
 // than a scene asking for more memory than the machine has. Called by assemble().
 void check_momentum_size(const Lagrangian& lagrangian, int dim);
 
+// A sparse Hessian pattern (Lagrangian::hessian_pattern) indexes the Hessian over (q, v) that the
+// evaluator and the constructions write through it: every row and column must lie within it, else
+// PluginFault from the Lagrangian, naming its plugin. Called by assemble().
+void check_hessian_pattern(const Lagrangian& lagrangian);
+
 // Creates the plugin objects and the construction; InputError for a construction that is not
 // available, a Lagrangian that does not fit the manifold, a bad initial state or an observable the
 // system does not define.

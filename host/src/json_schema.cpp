@@ -215,12 +215,15 @@ std::string message(const json& document, const json& instance, const Violation&
 // ---- what valijson is not given ------------------------------------------------------------------
 
 // Keywords a plugin's parameter schema may not use: references (remote ones would be fetched, a
-// self reference recurses without end) and regular expressions (std::regex's matching time and
-// stack depth are unbounded in the input's length). docs/security.md, "Plugins".
+// self reference recurses without end), regular expressions (std::regex's matching time and
+// stack depth are unbounded in the input's length) and uniqueItems (valijson compares every pair
+// of items, and in a branch such as allOf the host cannot check them first: 16,000 items took
+// seconds). docs/security.md, "Plugins".
 void check_plugin_schema(const json& node, const std::string& pointer) {
   if (node.is_boolean()) return;
   if (!node.is_object()) throw std::invalid_argument(fmt::format("{}: expected a schema (an object)", pointer));
-  static const std::set<std::string> refused{"$ref", "$id", "id", "pattern", "patternProperties", "format"};
+  static const std::set<std::string> refused{"$ref",   "$id",    "id",         "pattern", "patternProperties",
+                                             "format", "uniqueItems"};
   static const std::set<std::string> schema_maps{"properties", "definitions", "$defs", "dependencies"};
   static const std::set<std::string> schema_values{"items", "additionalItems", "additionalProperties", "not",
                                                    "contains", "propertyNames", "if", "then", "else",
@@ -241,8 +244,9 @@ void check_plugin_schema(const json& node, const std::string& pointer) {
   }
 }
 
-// Arrays whose schema asks for unique items are checked here, in n log n, before valijson (which
-// compares every pair and records an error for each pair of duplicates).
+// Arrays whose schema asks for unique items are checked here, in n log n, before valijson, which
+// is given the schema without them (without_unique_items): it compares every pair, distinct or
+// not, and records an error for each pair of duplicates.
 void check_unique_items(const json& document, const json& instance, std::vector<std::string>& tokens,
                         const std::string& prefix) {
   if (instance.is_object()) {
@@ -267,6 +271,19 @@ void check_unique_items(const json& document, const json& instance, std::vector<
   }
 }
 
+// The schema without its uniqueItems keywords (a boolean value: a property of that name has a
+// schema as its value). Only the host's own schemas have any (plugin schemas may not), where
+// check_unique_items finds them.
+json without_unique_items(json node) {
+  if (node.is_object()) {
+    if (auto it = node.find("uniqueItems"); it != node.end() && it->is_boolean()) node.erase(it);
+    for (auto& [key, value] : node.items()) value = without_unique_items(std::move(value));
+  } else if (node.is_array()) {
+    for (auto& value : node) value = without_unique_items(std::move(value));
+  }
+  return node;
+}
+
 }  // namespace
 
 void check_parameter_schema(const json& schema) { check_plugin_schema(schema, ""); }
@@ -282,7 +299,8 @@ SchemaValidator::SchemaValidator(json schema) : impl_(std::make_unique<Impl>()) 
   impl_->document = std::move(schema);
   try {
     valijson::SchemaParser parser(valijson::SchemaParser::kDraft7);
-    valijson::adapters::NlohmannJsonAdapter adapter(impl_->document);
+    const json checked = without_unique_items(impl_->document);
+    valijson::adapters::NlohmannJsonAdapter adapter(checked);
     parser.populateSchema(adapter, impl_->schema);
   } catch (const std::exception& e) {
     throw std::invalid_argument(std::string("not a usable JSON Schema: ") + e.what());

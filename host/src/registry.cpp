@@ -25,6 +25,7 @@
 #include <boost/dll/shared_library.hpp>
 
 #include "crash.hpp"
+#include "json_reader.hpp"
 #include "json_schema.hpp"
 #include "output.hpp"
 
@@ -173,10 +174,12 @@ std::string dlopen_error(const fs::path& file) {
   return error != nullptr ? error : "cannot be loaded";
 }
 
+// Metadata is read as a scene is (json_reader.hpp): bounded in size and nesting (every walk of a
+// schema recurses, and a schema nested 200,000 deep overflowed the stack), without repeated keys.
 nlohmann::json parse_metadata(const char* text, const char* what) {
   try {
-    return nlohmann::json::parse(text);
-  } catch (const nlohmann::json::exception& e) {
+    return parse_json_text(text);
+  } catch (const InputError& e) {
     throw Refused{fmt::format("malformed {} in varia_info: {}", what, e.what())};
   }
 }

@@ -23,9 +23,11 @@ using nlohmann::json;
 namespace {
 
 constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
-constexpr double kOrderSlack = 0.3;
+constexpr double kOrderSlack = 0.3;     // a fitted order may fall this far below the prediction
+constexpr double kOrderExcess = 1.0;    // and rise this far above it (more, no theorem explains it)
+constexpr double kSaneFactor = 1e6;     // an error this many times its scale: the run left every sane range
 // The widest range of local slopes over a fit that is still an asymptotic range (order_check).
-constexpr double kAsymptoticSpread = 1.0;     // a fitted order may fall this far below the prediction
+constexpr double kAsymptoticSpread = 1.0;
 constexpr double kDriftShare = 0.5;     // an energy error mostly trend (EnergyDrift::share) drifts
 constexpr long kLongRun = 4000;         // steps of the energy and momentum run at the scene's step
 constexpr double kOrderSpan = 20.0;     // global_order: the final time in scene steps
@@ -203,15 +205,36 @@ std::string fit_note(const OrderFit& fit, const std::string& what) {
   return note;
 }
 
+// An error that no integrator following the motion at all makes: not finite, or over kSaneFactor
+// times its scale (the state's size; 1 for L_d's relative error). Such a point measures no order:
+// it is thrown as a numerical failure, which measure_order drops and names, and `diverged` keeps
+// its step size for order_check.
+void check_sane(double error, double scale, double h, std::vector<double>& diverged) {
+  if (std::isfinite(error) && error <= kSaneFactor * scale) return;
+  diverged.push_back(h);
+  throw NumericalFailure(fmt::format("the run left every sane range: error {:.3g}, over {:g} times its scale {:.3g}",
+                                     error, kSaneFactor, scale),
+                         error);
+}
+
+std::string diverged_at(const std::vector<double>& diverged) {
+  return fmt::format("the runs at h = {:.4g} left every sane range (an error not finite or over {:g} times its "
+                     "scale)",
+                     fmt::join(diverged, ", "), kSaneFactor);
+}
+
+// A fitted order holds within [predicted - kOrderSlack, predicted + kOrderExcess]. Points that
+// diverged (check_sane) are dropped; where one lies below a step size that did not diverge, the
+// errors are not those of an asymptotic range, and the order is not measured.
 PropertyCheck order_check(const char* name, const std::optional<int>& predicted, const OrderFit& fit,
-                          const std::string& what) {
+                          const std::vector<double>& diverged, const std::string& what) {
   PropertyCheck c = check_of(name, prediction(predicted));
   c.tolerance = kOrderSlack;
   c.note = fit_note(fit, what);
   if (!fit.fitted()) {
-    c.note += fmt::format("; not measured: fewer than {} points in the asymptotic range above round-off (set the "
+    c.note += fmt::format("; not measured: fewer than {} points in the asymptotic range above round-off{} (set the "
                           "step sizes with --h)",
-                          kMinimumFitPoints);
+                          kMinimumFitPoints, diverged.empty() ? "" : "; " + diverged_at(diverged));
     return c;
   }
   c.measured = fit.slope;
@@ -227,6 +250,19 @@ PropertyCheck order_check(const char* name, const std::optional<int>& predicted,
                           "so the errors bend between the pre-asymptotic regime and round-off and {:.3g} measures no "
                           "order (set the step sizes with --h)",
                           fit.slope_spread, kAsymptoticSpread, fit.slope);
+  }
+  if (predicted && fit.slope > *predicted + kOrderExcess) {
+    c.holds = false;
+    c.note += fmt::format("; does not hold: {:.3g} is more than {} above the predicted order, which no theorem "
+                          "explains (errors falling this fast are not the method's asymptotic ones)",
+                          fit.slope, kOrderExcess);
+  }
+  const double largest = fit.h.front();  // the fit's step sizes, largest first
+  if (std::any_of(diverged.begin(), diverged.end(), [&](double h) { return h < largest; })) {
+    c.holds.reset();
+    c.note += fmt::format("; not measured: {}, below h = {:.4g}, which did not: these errors are not those of an "
+                          "asymptotic range",
+                          diverged_at(diverged), largest);
   }
   return c;
 }
@@ -328,7 +364,9 @@ PropertyCheck ld_order(Context& x) {
   const ExactLd exact = exact_ld(x, fine, reference);
   std::vector<double> q1(x.m);
   std::vector<OrderFit> fits;
-  for (const ExactLd::Base& base : exact.bases) {
+  std::vector<std::vector<double>> diverged(exact.bases.size());  // per base state (check_sane)
+  for (std::size_t b = 0; b < exact.bases.size(); ++b) {
+    const ExactLd::Base& base = exact.bases[b];
     double scale = 0.0;  // |L| along the curve, fixed at the first (largest) step size
     fits.push_back(ladder(
         x, "ld_order",
@@ -337,7 +375,9 @@ PropertyCheck ld_order(Context& x) {
           exact.at(base, h, q1, LdE);
           x.a.discrete_lagrangian->evaluate(base.q0.data(), q1.data(), h, &Ld, nullptr, nullptr);
           if (scale == 0.0) scale = std::max(std::abs(LdE) / h, kEpsilon);
-          return std::abs(Ld - LdE) / (h * scale);
+          const double error = std::abs(Ld - LdE) / (h * scale);
+          check_sane(error, 1.0, h, diverged[b]);
+          return error;
         },
         2.0 * x.scene.step, 1e3 * kEpsilon,
         // L_d's own round-off near this base state at h (it grows as h shrinks), ten times: a whole
@@ -355,9 +395,16 @@ PropertyCheck ld_order(Context& x) {
   }
   std::sort(fitted.begin(), fitted.end(), [](const OrderFit* a, const OrderFit* b) { return a->slope < b->slope; });
   const OrderFit& median = fitted.empty() ? fits.front() : *fitted[(fitted.size() - 1) / 2];
-  return order_check("ld_order", x.predictions.ld_order, median,
+  return order_check("ld_order", x.predictions.ld_order, median, diverged[&median - fits.data()],
                      x.predictions.reason + ". Measured: slope of |L_d - L_d^E| / (h |L|) against h; L_d^E from " +
                          exact.name + "; fitted orders " + slopes + ", the median's fit");
+}
+
+// max |c|; NaN when a value is NaN (std::max would drop it).
+double largest_magnitude(const std::vector<double>& values) {
+  double largest = 0.0;
+  for (double c : values) largest = std::isnan(c) ? c : std::max(largest, std::abs(c));
+  return largest;
 }
 
 double state_distance(Context& x, const double* q, const double* p, const double* qe, const double* pe) {
@@ -419,16 +466,23 @@ PropertyCheck global_order(Context& x) {
   double uncertainty = 0.0;
   const std::string reference = reference_state(x, T, std::lround(16 * kOrderSpan), qe, pe, uncertainty);
   const double scale = 1.0 + x.a.q0.lpNorm<Eigen::Infinity>() + x.a.p0.lpNorm<Eigen::Infinity>();
+  const double state_scale = scale + largest_magnitude(qe) + largest_magnitude(pe);  // at both ends
+  std::vector<double> diverged;
   const OrderFit fit = ladder(
       x, "global_order",
       [&](double& h) {
         const long steps = std::max(1L, std::lround(T / h));
         h = T / static_cast<double>(steps);
         final_state(*x.a.map, x, h, steps, q, p);
-        return state_distance(x, q.data(), p.data(), qe.data(), pe.data());
+        // A non-finite state is not handed to the manifold's chart.
+        const double error = std::isfinite(largest_magnitude(q) + largest_magnitude(p))
+                                 ? state_distance(x, q.data(), p.data(), qe.data(), pe.data())
+                                 : std::numeric_limits<double>::quiet_NaN();
+        check_sane(error, state_scale, h, diverged);
+        return error;
       },
       top, std::max(1e3 * kEpsilon * scale, 10 * uncertainty));
-  return order_check("global_order", x.predictions.global_order, fit,
+  return order_check("global_order", x.predictions.global_order, fit, diverged,
                      x.predictions.reason + fmt::format(". Measured: slope of the error at T = {:.3g} against h, against {}", T, reference));
 }
 

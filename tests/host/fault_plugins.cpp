@@ -60,6 +60,8 @@ TEST_CASE("plugins lists the good fault plugins and refuses each bad file with i
       {"fault_no_metadata.so", "missing metadata (no varia_info)"},
       {"fault_bad_schema.so", "unusable parameter_schema in varia_info: "},
       {"fault_bad_properties.so", "its properties declare \"symplectic\": \"yes\", expected true or false"},
+      // Issue 43, item 9: listing it overflowed the stack (exit 139).
+      {"fault_deep_schema.so", "malformed parameter_schema in varia_info: /not/not/not/not/not/not/not/not"},
   };
   const auto table = run_varia("plugins " + faults.flag());
   CAPTURE(table.out);
@@ -89,6 +91,9 @@ TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) namin
       {"fault-abi", 3, "fault_wrong_abi.so", "ABI version"},
       {"fault-no-info", 3, "fault_no_metadata.so", "missing metadata (no varia_info)"},
       {"fault-bad-schema", 3, "fault_bad_schema.so", "unusable parameter_schema"},
+      // Issue 43, item 10: the pattern was written through, and varia died of SIGSEGV (exit 139).
+      {"fault-bad-pattern", 3, "fault_bad_hessian_pattern.so",
+       "sparse Hessian pattern names entry 3 at (row 268435456, column 268435456), outside its 2 x 2 Hessian"},
   };
   for (const auto& c : cases) {
     CAPTURE(c.lagrangian);
@@ -103,6 +108,25 @@ TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) namin
     check_one_error_line(outcome, (faults.dir / c.file).string());
     CHECK(contains(outcome.err, c.reason));
   }
+}
+
+// Issue 43, item 10: the composite read its coordinates through the pattern unchecked.
+TEST_CASE("an effect whose Hessian pattern lies outside its coordinates is a plugin fault naming its file, exit 3") {
+  const FaultDirectory faults;
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "default.json"));
+  scene["system"]["lagrangian"] = {{"type", "composite"},
+                                   {"space_dim", 1},
+                                   {"masses", {1.0}},
+                                   {"terms", {{{"type", "fault-bad-effect-pattern"}}}}};
+  scene.erase("observe");
+  const auto file = faults.dir / "bad_effect.json";
+  write_file(file, scene.dump());
+  const auto outcome = run_varia("validate '" + file.string() + "' " + faults.flag());
+  CAPTURE(outcome.err);
+  CHECK(outcome.code == 3);
+  check_one_error_line(outcome, (faults.dir / "fault_bad_effect_pattern.so").string());
+  CHECK(contains(outcome.err, "terms/0: the effect's Hessian pattern names entry 1 at (row 268435456, column 0), "
+                              "outside its 1 coordinates"));
 }
 
 TEST_CASE("a plugin fault in the middle of a run leaves a run record that notes it") {
