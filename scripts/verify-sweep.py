@@ -3,12 +3,13 @@
 and tallies the order rows: every "holds" must lie in [predicted - 0.3, predicted + 1], and every
 "does not hold" is listed for an independent check. docs/verify.md reports the last sweep.
 
-Usage: scripts/verify-sweep.py [VARIA] [--out DIR] [--jobs N]
+Usage: scripts/verify-sweep.py [VARIA] [--out DIR] [--jobs N] [--only REGEX]
 Writes DIR/sweep.json (every composition, its exit code and checks) and prints the tally.
 """
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
 from concurrent.futures import ThreadPoolExecutor
@@ -90,10 +91,12 @@ def main():
     parser.add_argument("varia", nargs="?", default="build/bin/varia")
     parser.add_argument("--out", default="out/verify-sweep")
     parser.add_argument("--jobs", type=int, default=2)
+    parser.add_argument("--only", default="", help="the compositions whose name matches this regular expression")
     args = parser.parse_args()
     os.makedirs(args.out, exist_ok=True)
     with ThreadPoolExecutor(args.jobs) as pool:
-        results = list(pool.map(lambda item: verify(args.varia, args.out, *item), compositions()))
+        chosen = [item for item in compositions() if re.search(args.only, item[0])]
+        results = list(pool.map(lambda item: verify(args.varia, args.out, *item), chosen))
     with open(os.path.join(args.out, "sweep.json"), "w") as f:
         json.dump(results, f, indent=1)
     verified = [r for r in results if "checks" in r]

@@ -98,6 +98,7 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
   }
   fit.used = static_cast<int>(kept.size());
   if (!fit.fitted()) return fit;
+  fit.h_span = h[kept.front()] / h[kept.back()];
   fit.slope = log_log_slope(h, error, kept);
   // The order is the limit of the local slope as h -> 0. While a term of the next order still
   // shows, the local slopes creep towards it geometrically (s(h) = p + c h^k on a geometric
@@ -143,6 +144,9 @@ OrderFit measure_order(const ErrorAt& error_at, double h_top, double h_max, doub
           error = 0.0;
         }
       }
+      // A step size the measurement rounded to one already measured (a whole number of steps to
+      // a final time) is one point, not two.
+      if (std::find(hs.begin(), hs.end(), h) != hs.end()) return true;
       const auto at = std::find_if(hs.begin(), hs.end(), [&](double other) { return other < h; });
       errors.insert(errors.begin() + (at - hs.begin()), error);
       hs.insert(at, h);

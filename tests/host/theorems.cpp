@@ -207,6 +207,19 @@ TEST_CASE("a correct high-order galerkin is never reported as not holding its ld
   CAPTURE(spectral["ld_order"].note);
   CHECK_FALSE(spectral["ld_order"].holds == false);
 
+  // The sweep's false alarms (scripts/verify-sweep.py on 236e5fd): a median of base states that
+  // disagree (16.8, 9.53, 12.4), and a fit over a factor 1.68 in h.
+  const Verified disagreeing(scene_of({{"type", "pendulum"}}, galerkin(5, "gauss-legendre", 6), 1.3, 0.1));
+  CAPTURE(disagreeing["ld_order"].note);
+  CHECK_FALSE(disagreeing["ld_order"].holds == false);
+  json kepler = scene_of({{"type", "kepler"}}, galerkin(6, "gauss-lobatto", 8), 0.0, 0.05);
+  kepler["system"]["manifold"]["dim"] = 2;
+  kepler["initial"] = {{"q", {0.5, 0.0}}, {"v", {0.0, std::sqrt(3.0)}}};
+  const Verified narrow(kepler);
+  CAPTURE(narrow["ld_order"].note);
+  CHECK_FALSE(narrow["ld_order"].holds == false);
+  CHECK_FALSE(narrow["global_order"].holds == false);
+
   fpu["method"] = galerkin(6, "gauss-legendre", 6);  // order 12, no exact solution: the reference's own order
   const Verified capped(fpu);
   CAPTURE(capped["ld_order"].note);

@@ -48,6 +48,9 @@ struct OrderFit {
   // 0.3, the fit has no asymptotic range (the errors bend between the pre-asymptotic regime and
   // round-off) and its slope measures no order.
   double slope_spread = 0.0;
+  // The largest fitted step size over the smallest: below a factor 2 no local slope can be formed,
+  // and a slope over so narrow a range measures no order.
+  double h_span = 0.0;
   bool fitted() const { return used >= kMinimumFitPoints; }
 };
 OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& error, double floor);
