@@ -413,11 +413,15 @@ PropertyCheck ld_order(Context& x) {
                                 x.predictions.reason + ". Measured: slope of |L_d - L_d^E| / (h |L|) against h; L_d^E "
                                 "from " + exact.name + "; fitted orders " + slopes + ", the median's fit");
   // The base states measure one order; where their fits disagree by more than kAsymptoticSpread,
-  // none of them is in a range common to all, and a median outside the prediction measures nothing.
+  // none of them is in a range common to all, and where only one has a fit, nothing confirms it: a
+  // median outside the prediction then measures nothing.
   if (c.holds == false && fitted.size() >= 2 && fitted.back()->slope - fitted.front()->slope > kAsymptoticSpread) {
     c.holds.reset();
     c.note += fmt::format("; not measured: the base states' fitted orders ({}) disagree by more than {}",
                           slopes, kAsymptoticSpread);
+  } else if (c.holds == false && fitted.size() < 2) {
+    c.holds.reset();
+    c.note += fmt::format("; not measured: only one of the {} base states has a fit ({})", kBases, slopes);
   }
   return c;
 }

@@ -219,6 +219,10 @@ TEST_CASE("a correct high-order galerkin is never reported as not holding its ld
   CAPTURE(narrow["ld_order"].note);
   CHECK_FALSE(narrow["ld_order"].holds == false);
   CHECK_FALSE(narrow["global_order"].holds == false);
+  kepler["method"] = galerkin(8, "gauss-lobatto", 9);  // one base state of three fitted, at 7.84
+  const Verified alone(kepler);
+  CAPTURE(alone["ld_order"].note);
+  CHECK_FALSE(alone["ld_order"].holds == false);
 
   fpu["method"] = galerkin(6, "gauss-legendre", 6);  // order 12, no exact solution: the reference's own order
   const Verified capped(fpu);
