@@ -245,7 +245,7 @@ std::string weak_fit(const OrderFit& fit, bool low) {
 // A fitted order holds within [predicted - kOrderSlack, predicted + kOrderExcess]. Points that
 // diverged (check_sane) are dropped; where one lies below a step size that did not diverge, the
 // errors are not those of an asymptotic range, and the order is not measured.
-PropertyCheck order_check(const char* name, const std::optional<int>& predicted, const OrderFit& fit,
+PropertyCheck order_check(const char* name, const std::optional<int>& predicted, bool bound, const OrderFit& fit,
                           const std::vector<double>& diverged, const std::string& what) {
   PropertyCheck c = check_of(name, prediction(predicted));
   c.tolerance = kOrderSlack;
@@ -265,6 +265,12 @@ PropertyCheck order_check(const char* name, const std::optional<int>& predicted,
     if (const std::string why = weak_fit(fit, low); !why.empty()) {
       c.holds.reset();
       c.note += fmt::format("; not measured: {} (set the step sizes with --h)", why);
+    } else if (high && bound) {
+      c.holds.reset();
+      c.note += fmt::format("; not measured: {:.3g} is more than {} above the predicted order, which the theorem "
+                            "gives as a lower bound that this system exceeds (a Lagrangian constant along the flow "
+                            "makes any rule exact), so the prediction is not what was measured",
+                            fit.slope, kOrderExcess);
     } else if (high) {
       c.note += fmt::format("; does not hold: {:.3g} is more than {} above the predicted order, which no theorem "
                             "explains (errors falling this fast are not the method's asymptotic ones)",
@@ -409,7 +415,8 @@ PropertyCheck ld_order(Context& x) {
   }
   std::sort(fitted.begin(), fitted.end(), [](const OrderFit* a, const OrderFit* b) { return a->slope < b->slope; });
   const OrderFit& median = fitted.empty() ? fits.front() : *fitted[(fitted.size() - 1) / 2];
-  PropertyCheck c = order_check("ld_order", x.predictions.ld_order, median, diverged[&median - fits.data()],
+  PropertyCheck c = order_check("ld_order", x.predictions.ld_order, x.predictions.orders_are_bounds, median,
+                                diverged[&median - fits.data()],
                                 x.predictions.reason + ". Measured: slope of |L_d - L_d^E| / (h |L|) against h; L_d^E "
                                 "from " + exact.name + "; fitted orders " + slopes + ", the median's fit");
   // The base states measure one order; where their fits disagree by more than kAsymptoticSpread,
@@ -508,7 +515,7 @@ PropertyCheck global_order(Context& x) {
         return error;
       },
       top, std::max(1e3 * kEpsilon * scale, 10 * uncertainty));
-  return order_check("global_order", x.predictions.global_order, fit, diverged,
+  return order_check("global_order", x.predictions.global_order, x.predictions.orders_are_bounds, fit, diverged,
                      x.predictions.reason + fmt::format(". Measured: slope of the error at T = {:.3g} against h, against {}", T, reference));
 }
 

@@ -119,6 +119,7 @@ class Galerkin final : public Construction {
     const Determination d = determination(*a.quadrature, options(scene).degree);
     Predictions p;
     p.ld_order = p.global_order = d.order;
+    p.orders_are_bounds = true;
     if (a.manifold->is_vector_space()) p.self_adjoint = a.quadrature->symmetric();
     p.symplectic = p.energy_bounded = true;
     p.reason = "Galerkin (sec. 2): " + d.how +

@@ -64,6 +64,7 @@ class Shooting final : public Construction {
     const bool type_2 = options(scene).form == "type-2";
     Predictions p;
     p.ld_order = p.global_order = std::min(method.order, quadrature_order(*a.quadrature));
+    p.orders_are_bounds = true;
     if (!type_2) p.self_adjoint = method.self_adjoint && a.quadrature->symmetric();
     p.symplectic = p.energy_bounded = true;
     p.reason = "shooting (sec. 3 theorem): order min(p, q); self-adjoint for a self-adjoint method and a symmetric "

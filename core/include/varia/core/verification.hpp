@@ -21,6 +21,9 @@ namespace varia {
 struct Predictions {
   std::optional<bool> self_adjoint, g_invariant, momentum_conserved, symplectic, energy_bounded;
   std::optional<int> ld_order, global_order;
+  // The orders are the theorems' lower bounds (order at least min(p, q)), which a particular system
+  // may exceed (a Lagrangian constant along the flow makes any rule exact), not a declared order.
+  bool orders_are_bounds = false;
   std::string reason;  // the theorem each prediction comes from, for the report
 };
 
