@@ -59,7 +59,7 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
         "the Lagrangian's Hessian at jets of at least 2 variables (Lagrangian::hessian_jet: the acceleration "
         "M^{-1} (L_q - L_vq v) and its second-order jets need L's derivatives to fourth order); this one has "
         "no constant mass matrix and gives no Hessian at jets (models derived from sdk::AutodiffLagrangian give "
-        "it for at most sdk::kStackVariables = 18 position and velocity numbers together, docs/shooting.md). "
+        "it at every size; sdk::TermwiseLagrangian and hand-written ones may not, docs/shooting.md). "
         "Integrate in (q, p): the shooting construction's \"form\": \"hamiltonian\"");
   v_.setZero();
 }

@@ -250,6 +250,73 @@ TEST_CASE("hessian_jet at jets of 1 to 6 variables (forward over forward mode wi
   }
 }
 
+namespace {
+
+// n coupled pendulums with configuration-dependent masses, L = sum_i [1/2 v_i^2 (2 + sin q_i) + cos q_i]
+// + 1/2 sum_i cos(q_i - q_{i+1}), sizes read at run time, with its Hessian written out for jet arithmetic.
+struct VaryingMassChain : varia::sdk::AutodiffLagrangian<VaryingMassChain> {
+  explicit VaryingMassChain(int n) : varia::sdk::AutodiffLagrangian<VaryingMassChain>(n, n), n_(n) {}
+  template <class T>
+  T lagrangian(const varia::sdk::Vec<T>& q, const varia::sdk::Vec<T>& v) const {
+    using std::cos;
+    using std::sin;
+    T L = T(0.0);
+    for (int i = 0; i < n_; ++i) L += 0.5 * v(i) * v(i) * (2.0 + sin(q(i))) + cos(q(i));
+    for (int i = 0; i + 1 < n_; ++i) L += 0.5 * cos(q(i) - q(i + 1));
+    return L;
+  }
+  // Column-major in z = (q, v).
+  template <class T>
+  std::vector<T> hessian(const T* q, const T* v) const {
+    using std::cos;
+    using std::sin;
+    const int k = 2 * n_;
+    std::vector<T> H(k * k, T(0.0));
+    auto add = [&](int r, int c, const T& x) { H[c * k + r] = H[c * k + r] + x; };
+    for (int i = 0; i < n_; ++i) {
+      add(i, i, -(0.5 * v[i] * v[i] * sin(q[i])) - cos(q[i]));
+      add(i, n_ + i, v[i] * cos(q[i]));
+      add(n_ + i, i, v[i] * cos(q[i]));
+      add(n_ + i, n_ + i, 2.0 + sin(q[i]));
+    }
+    for (int i = 0; i + 1 < n_; ++i) {
+      const T c = 0.5 * cos(q[i] - q[i + 1]);
+      add(i, i, -c), add(i + 1, i + 1, -c), add(i, i + 1, c), add(i + 1, i, c);
+    }
+    return H;
+  }
+  int n_;
+};
+
+}  // namespace
+
+TEST_CASE("hessian_jet above the stack size (a dense model of 10 + 10 numbers with a configuration-dependent mass "
+          "matrix, over the workspace's dual numbers) equals jet arithmetic on the written-out Hessian at jets of 1 "
+          "to 6 variables and at constants (issue #39: it was refused above 18 numbers)") {
+  VaryingMassChain model(10);
+  CHECK(model.hessian_jet_variables() == 6);
+  const int k = 20;
+  for (int N = 1; N <= 6; ++N) {
+    CAPTURE(N);
+    const std::vector<varia::Jet2> z = jet_inputs(k, N);
+    std::vector<varia::Jet2> hessian(k * k);
+    REQUIRE(model.hessian_jet(z.data(), z.data() + 10, hessian.data()) == nullptr);
+    const std::vector<varia::Jet2> expected = model.hessian(z.data(), z.data() + 10);
+    double worst = 0.0;
+    for (int i = 0; i < k * k; ++i) worst = std::max(worst, jet_distance(hessian[i], expected[i], N));
+    CHECK(worst < 1e-14);
+  }
+  const std::vector<varia::Jet2> constants(k, varia::Jet2(0.4));
+  std::vector<varia::Jet2> hessian(k * k);
+  REQUIRE(model.hessian_jet(constants.data(), constants.data() + 10, hessian.data()) == nullptr);
+  const std::vector<double> at(k, 0.4);
+  const std::vector<double> expected = model.hessian(at.data(), at.data() + 10);
+  for (int i = 0; i < k * k; ++i) {
+    CHECK(hessian[i].constant());
+    CHECK(hessian[i].value == doctest::Approx(expected[i]).epsilon(1e-15));
+  }
+}
+
 TEST_CASE("above the stack size a dense autodiff Lagrangian evaluates at jets (over its workspace's dual numbers): "
           "a Morse chain of 5 particles (20 numbers) gives the sum of its 4 bonds' gradient jets, each a 2-particle "
           "chain of 8 numbers on the stack path, and of the kinetic term's") {

@@ -19,9 +19,9 @@
 // evaluated at dual numbers over second-order jets (kJetDirections derivative directions at a
 // time), gives gradient_jet at any size (sizes read at run time: over inputs kept in a workspace
 // sized once). Forward mode over forward mode at jet values (jet_tangent.hpp)
-// gives hessian_jet at jets of up to 6 variables, which the shooting construction's lagrangian
-// form needs for a configuration-dependent mass matrix (it propagates in passes of at most that
-// many variables: any dimension up to kStackVariables / 2). The same first-order pass, inlined into
+// gives hessian_jet at jets of up to 6 variables and any size, which the shooting construction's
+// lagrangian form needs for a configuration-dependent mass matrix (it propagates in passes of at
+// most that many variables). The same first-order pass, inlined into
 // one loop, gives the gradients at several points in one call (gradients) and runs the Galerkin
 // explicit form's Stormer-Verlet steps inside the plugin (kernel::StormerVerletSteps).
 #pragma once
@@ -71,7 +71,11 @@ class AutodiffLagrangian : public Lagrangian {
       chunk_q_.resize(m_), chunk_v_.resize(n_);
       chunk2_q_.resize(m_), chunk2_v_.resize(n_);
     }
-    if (!kFixed) jet_q_.resize(m_), jet_v_.resize(n_);
+    if (!kFixed) {
+      jet_q_.resize(m_), jet_v_.resize(n_);
+      hessian_jet_q_.resize(m_), hessian_jet_v_.resize(n_), hessian_jet_z_.resize(m_ + n_);
+    }
+    at_constants_.resize(m_ + n_), hessian_at_constants_.resize((m_ + n_) * (m_ + n_));
   }
   int position_size() const noexcept final { return m_; }
   int velocity_size() const noexcept final { return n_; }
@@ -171,20 +175,21 @@ class AutodiffLagrangian : public Lagrangian {
       }
     });
   }
-  int hessian_jet_variables() const noexcept final { return m_ + n_ <= kStackVariables ? kMaxHessianJetVariables : 0; }
+  int hessian_jet_variables() const noexcept final { return kMaxHessianJetVariables; }
   Status hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian) noexcept final {
     return guarded(error_, [&] {
-      if (m_ + n_ > kStackVariables)
-        throw std::length_error("an autodiff Lagrangian gives its Hessian at jets for at most " +
-                                std::to_string(kStackVariables) + " position and velocity numbers together");
       const int variables = jet_variables(q, v);
       if (variables == 0) return hessian_at_constants(q, v, hessian);
-      if constexpr (kFixedJetVariables > 0 && kFixedJetVariables < kMaxHessianJetVariables)
-        if (variables <= kFixedJetVariables) return hessian_at_fixed_jets<kFixedJetVariables>(q, v, variables, hessian);
-      if (variables <= kMaxHessianJetVariables)
-        return hessian_at_fixed_jets<kMaxHessianJetVariables>(q, v, variables, hessian);
-      throw std::length_error("an autodiff Lagrangian gives its Hessian at jets of at most " +
-                              std::to_string(kMaxHessianJetVariables) + " variables (hessian_jet_variables())");
+      if (variables > kMaxHessianJetVariables)
+        throw std::length_error("an autodiff Lagrangian gives its Hessian at jets of at most " +
+                                std::to_string(kMaxHessianJetVariables) + " variables (hessian_jet_variables())");
+      if constexpr (kFixed) {
+        if constexpr (kFixedJetVariables > 0 && kFixedJetVariables < kMaxHessianJetVariables)
+          if (variables <= kFixedJetVariables) return hessian_at_stack_jets<kFixedJetVariables>(q, v, variables, hessian);
+        hessian_at_stack_jets<kMaxHessianJetVariables>(q, v, variables, hessian);
+      } else {
+        hessian_at_jets(hessian_jet_q_, hessian_jet_v_, hessian_jet_z_.data(), q, v, variables, hessian);
+      }
     });
   }
 
@@ -379,14 +384,20 @@ class AutodiffLagrangian : public Lagrangian {
   // derivatives): forward over forward mode with jet values, the outer level
   // Eigen's AutoDiffScalar, the inner a JetTangent (jet_tangent.hpp), kHessianJetDirections
   // directions each: one pass of the model per pair of blocks (a, b), b >= a, whose second
-  // derivatives give H(a.., b..) and, by symmetry, H(b.., a..).
+  // derivatives give H(a.., b..) and, by symmetry, H(b.., a..). Sizes given at compile time: over
+  // dual inputs on the stack; read at run time: over the workspace's (any size).
   template <int N>
-  void hessian_at_fixed_jets(const Jet2* q, const Jet2* v, int variables, Jet2* hessian) const {
+  void hessian_at_stack_jets(const Jet2* q, const Jet2* v, int variables, Jet2* hessian) const {
+    std::array<FixedJet<N>, kMaxFixedVariables> z;
+    Vec<HessianJetDual<N>> qd(m_), vd(n_);
+    hessian_at_jets(qd, vd, z.data(), q, v, variables, hessian);
+  }
+  template <class Outer, int N>
+  void hessian_at_jets(Vec<Outer>& qd, Vec<Outer>& vd, FixedJet<N>* z, const Jet2* q, const Jet2* v, int variables,
+                       Jet2* hessian) const {
     constexpr int K = kHessianJetDirections;
-    using Inner = JetTangent<FixedJet<N>, K>;
-    using Outer = Eigen::AutoDiffScalar<Eigen::Matrix<Inner, K, 1>>;
+    using Inner = typename Outer::Scalar;
     const int k = m_ + n_;
-    std::array<FixedJet<N>, kStackVariables> z;
     for (int i = 0; i < k; ++i) {
       const Jet2& x = at(q, v, m_, i);
       z[i] = FixedJet<N>(x.value);
@@ -395,20 +406,20 @@ class AutodiffLagrangian : public Lagrangian {
       z[i].gradient.head(variables) = x.gradient;
       z[i].hessian.topLeftCorner(variables, variables) = x.hessian;
     }
-    Vec<Outer> qd(m_), vd(n_);
     for (int a = 0; a < k; a += K)
       for (int b = a; b < k; b += K) {
         for (int i = 0; i < k; ++i) {
           Outer& x = input(qd, vd, i);
           x.value() = Inner(z[i]);
           if (i >= b && i < b + K) x.value().derivatives[i - b] = FixedJet<N>(1.0);
+          x.derivatives().resize(K);
           for (int j = 0; j < K; ++j) x.derivatives()(j) = Inner(i == a + j ? 1.0 : 0.0);
         }
         const Outer r = model().lagrangian(qd, vd);
         for (int j = 0; j < K && a + j < k; ++j)
           for (int i = 0; i < K && b + i < k; ++i)
             hessian[(a + j) * k + b + i] = hessian[(b + i) * k + a + j] =
-                truncated(r.derivatives()(j).derivatives[i], variables);
+                truncated(derivative(r, j).derivatives[i], variables);
       }
   }
   template <int N>
@@ -418,13 +429,14 @@ class AutodiffLagrangian : public Lagrangian {
     jet.hessian = x.hessian.topLeftCorner(variables, variables);
     return jet;
   }
-  // Constant inputs: the Hessian at their values, as constant jets.
+  // Constant inputs: the Hessian at their values (evaluate's, at any size), as constant jets.
   void hessian_at_constants(const Jet2* q, const Jet2* v, Jet2* hessian) {
     const int k = m_ + n_;
-    for (int i = 0; i < k; ++i) input(q_, v_, i) = at(q, v, m_, i).value;
-    std::array<double, kStackVariables * kStackVariables> values;
-    second_order<SecondDual>(q_.data(), v_.data(), nullptr, nullptr, values.data());
-    for (int i = 0; i < k * k; ++i) hessian[i] = Jet2(values[i]);
+    for (int i = 0; i < k; ++i) at_constants_[i] = at(q, v, m_, i).value;
+    if (const Status status = evaluate(at_constants_.data(), at_constants_.data() + m_, nullptr, nullptr,
+                                       hessian_at_constants_.data()))
+      throw std::runtime_error(status);
+    for (int i = 0; i < k * k; ++i) hessian[i] = Jet2(hessian_at_constants_[i]);
   }
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).
@@ -483,6 +495,9 @@ class AutodiffLagrangian : public Lagrangian {
   Vec<ChunkJetDual> jet_q_, jet_v_;
   Vec<ChunkDual> chunk_q_, chunk_v_;
   Vec<ChunkDual2> chunk2_q_, chunk2_v_;
+  Vec<ChunkHessianJetDual> hessian_jet_q_, hessian_jet_v_;
+  std::vector<FixedJet<kMaxHessianJetVariables>> hessian_jet_z_;
+  std::vector<double> at_constants_, hessian_at_constants_;
 };
 
 }  // namespace varia::sdk

@@ -15,6 +15,7 @@
 #include <unsupported/Eigen/AutoDiff>
 
 #include "varia/core/jet.hpp"
+#include "varia/sdk/jet_tangent.hpp"
 
 namespace varia::sdk {
 
@@ -30,7 +31,8 @@ inline constexpr int kChunkDirections = 8;
 inline constexpr int kJetDirections = 4;
 // L's Hessian at jet inputs (Lagrangian::hessian_jet) is taken kHessianJetDirections by
 // kHessianJetDirections numbers of (q, v) at a time, at jets of up to kMaxHessianJetVariables
-// variables (FixedJet: a second-order scalar over FixedJet<6> holds 9 x 43 doubles).
+// variables (FixedJet: a second-order scalar over FixedJet<6> holds 9 x 43 doubles), at any
+// number of (q, v).
 inline constexpr int kHessianJetDirections = 2;
 inline constexpr int kMaxHessianJetVariables = 6;
 // The shooting construction's shot runs inside the plugin (kernel::ExplicitShot) with fixed-size jets
@@ -58,6 +60,16 @@ using JetDual = Eigen::AutoDiffScalar<Eigen::Matrix<J, K, 1>>;
 // The dual number over jets of models whose sizes are read at run time: kJetDirections directions
 // (fewer in the last block), a type of its own whose Vec holds any number of inputs.
 using ChunkJetDual = Eigen::AutoDiffScalar<Bounded<Jet2, kJetDirections>>;
+// The second-order scalar of L's Hessian at jets of N variables: forward over forward mode with jet
+// values (jet_tangent.hpp), kHessianJetDirections directions at each level; for models whose sizes
+// are given at compile time, so that a Vec of them lives on the stack.
+template <int N>
+using HessianJetDual = Eigen::AutoDiffScalar<
+    Eigen::Matrix<JetTangent<FixedJet<N>, kHessianJetDirections>, kHessianJetDirections, 1>>;
+// The same for models whose sizes are read at run time: a type of its own (its outer directions
+// capacity-bounded), whose Vec holds any number of inputs, kept in a workspace sized once.
+using ChunkHessianJetDual = Eigen::AutoDiffScalar<
+    Bounded<JetTangent<FixedJet<kMaxHessianJetVariables>, kHessianJetDirections>, kHessianJetDirections>>;
 // The large systems' dual numbers: kChunkDirections directions (fewer in the last chunk).
 using ChunkDual = Eigen::AutoDiffScalar<Bounded<double, kChunkDirections>>;
 using ChunkDual2 = Eigen::AutoDiffScalar<Bounded<ChunkDual, kChunkDirections>>;
@@ -75,6 +87,8 @@ template <>
 struct OnStack<ChunkDual2> : std::false_type {};
 template <>
 struct OnStack<ChunkJetDual> : std::false_type {};
+template <>
+struct OnStack<ChunkHessianJetDual> : std::false_type {};
 
 // The vectors q and v a model's lagrangian<T>(q, v) takes.
 template <class T>
