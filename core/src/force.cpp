@@ -1,4 +1,4 @@
-#include "varia/core/force.hpp"
+#include "varia/abi/force.hpp"
 
 #include <cmath>
 #include <stdexcept>

@@ -9,11 +9,11 @@
 
 #include "scene.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/force.hpp"
-#include "varia/core/lagrangian.hpp"
-#include "varia/core/manifold.hpp"
-#include "varia/core/one_step.hpp"
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/force.hpp"
+#include "varia/abi/lagrangian.hpp"
+#include "varia/abi/manifold.hpp"
+#include "varia/abi/one_step.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "varia/core/verification.hpp"
 
 namespace varia::host {

@@ -19,7 +19,7 @@
 #include "interrupt.hpp"
 #include "output.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia::host {
 

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "scene.hpp"
-#include "varia/core/lagrangian.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/lagrangian.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/core/mechanics.hpp"
 
 namespace varia::host {

@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "errors.hpp"
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/plugin_object.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::host {

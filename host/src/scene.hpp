@@ -11,7 +11,7 @@
 #include "constructions/construction.hpp"
 #include "json_reader.hpp"  // read_json_file
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/manifold.hpp"
 
 namespace varia::host {
 

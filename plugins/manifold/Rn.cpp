@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "varia/core/manifold.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace {

@@ -13,7 +13,7 @@
 #include <type_traits>
 #include <vector>
 
-#include "varia/core/one_step.hpp"
+#include "varia/abi/one_step.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace {

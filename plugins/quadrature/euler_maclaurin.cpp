@@ -9,7 +9,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace {

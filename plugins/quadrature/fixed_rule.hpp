@@ -4,7 +4,7 @@
 
 #include <array>
 
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "varia/sdk/no_parameters.hpp"
 #include "varia/sdk/plugin.hpp"
 

@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/quadrature.hpp"
 
 namespace varia::plugins::legendre {
 

@@ -5,7 +5,7 @@
 
 #include <cmath>
 
-#include "varia/core/force.hpp"
+#include "varia/abi/force.hpp"
 
 namespace varia::testing {
 

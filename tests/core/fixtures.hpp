@@ -4,8 +4,8 @@
 #include <cmath>
 #include <vector>
 
-#include "varia/core/manifold.hpp"
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/manifold.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "varia/core/so3.hpp"
 #include "varia/sdk/autodiff_lagrangian.hpp"
 #include "varia/sdk/groups/so3.hpp"

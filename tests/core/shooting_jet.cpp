@@ -1,6 +1,6 @@
-// Second-order jets (varia/core/jet.hpp) and one-step methods stepped at jets: the derivatives
+// Second-order jets (varia/abi/jet.hpp) and one-step methods stepped at jets: the derivatives
 // that the shooting construction relies on.
-#include "varia/core/jet.hpp"
+#include "varia/abi/jet.hpp"
 
 #include <doctest/doctest.h>
 

@@ -14,7 +14,7 @@
 
 #include "core/fixtures.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/one_step.hpp"
+#include "varia/abi/one_step.hpp"
 #include "varia/sdk/conformance/loader.hpp"
 
 namespace varia::testing {

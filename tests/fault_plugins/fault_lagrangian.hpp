@@ -5,7 +5,7 @@
 // and without the AD SDK each compiles in a second or two.
 #pragma once
 
-#include <varia/core/lagrangian.hpp>
+#include <varia/abi/lagrangian.hpp>
 #include <varia/sdk/plugin.hpp>
 
 namespace varia::test {

@@ -4,7 +4,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include <varia/core/manifold.hpp>
+#include <varia/abi/manifold.hpp>
 #include <varia/sdk/no_parameters.hpp>
 #include <varia/sdk/plugin.hpp>
 

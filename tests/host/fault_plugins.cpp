@@ -15,7 +15,7 @@
 #include "commands.hpp"
 #include "host/support.hpp"
 #include "registry.hpp"
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia::test {
 namespace {

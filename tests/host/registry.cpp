@@ -10,7 +10,7 @@
 #include <map>
 
 #include "host/support.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/manifold.hpp"
 
 namespace varia::host {
 namespace {

@@ -1,4 +1,4 @@
-// The effect plugins (core/effect.hpp): the SDK's effect suite (Taylor tests of the gradient and
+// The effect plugins (abi/effect.hpp): the SDK's effect suite (Taylor tests of the gradient and
 // sparse Hessian, varia/sdk/conformance/effect.hpp) over every effect plugin built, and the
 // force suite over every force plugin; and the composite Lagrangian they make
 // (core/composite.hpp) integrated by the sparse Galerkin construction against an independent

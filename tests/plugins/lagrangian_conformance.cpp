@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "load_plugin.hpp"
-#include "varia/core/lagrangian.hpp"
+#include "varia/abi/lagrangian.hpp"
 #include "varia/sdk/conformance/lagrangian.hpp"
 #include "varia/sdk/conformance/plugin.hpp"
 

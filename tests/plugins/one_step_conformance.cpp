@@ -11,7 +11,7 @@
 
 #include "plugins/load_plugin.hpp"
 #include "varia/core/mechanical_field.hpp"
-#include "varia/core/one_step.hpp"
+#include "varia/abi/one_step.hpp"
 #include "varia/sdk/autodiff_lagrangian.hpp"
 
 namespace {

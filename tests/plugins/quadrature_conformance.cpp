@@ -14,8 +14,8 @@
 
 #include "plugins/load_plugin.hpp"
 #include "varia/sdk/conformance/quadrature.hpp"
-#include "varia/core/manifold.hpp"
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/manifold.hpp"
+#include "varia/abi/quadrature.hpp"
 
 namespace {
 

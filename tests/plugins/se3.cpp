@@ -18,12 +18,12 @@
 
 #include "load_plugin.hpp"
 #include "varia/core/galerkin_chart.hpp"
-#include "varia/core/lagrangian.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/lagrangian.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/core/mechanics.hpp"
-#include "varia/core/one_step.hpp"
+#include "varia/abi/one_step.hpp"
 #include "varia/core/one_step_map.hpp"
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "varia/core/shooting.hpp"
 
 namespace {

@@ -10,8 +10,8 @@
 #include <cmath>
 
 #include "varia/core/galerkin.hpp"
-#include "varia/core/manifold.hpp"
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/manifold.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "core/shooting_fixtures.hpp"
 #include "varia/sdk/autodiff_lagrangian.hpp"
 

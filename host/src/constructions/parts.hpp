@@ -9,7 +9,7 @@
 #include "../assemble.hpp"
 #include "../registry.hpp"
 #include "../scene.hpp"
-#include "varia/core/force.hpp"
+#include "varia/abi/force.hpp"
 #include "varia/core/verification.hpp"
 
 namespace varia::host {

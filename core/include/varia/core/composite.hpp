@@ -13,9 +13,9 @@
 #include <type_traits>
 #include <vector>
 
-#include "varia/core/effect.hpp"
-#include "varia/core/lagrangian.hpp"
-#include "varia/core/sparse_pattern.hpp"
+#include "varia/abi/effect.hpp"
+#include "varia/abi/lagrangian.hpp"
+#include "varia/abi/sparse_pattern.hpp"
 
 namespace varia {
 

@@ -21,8 +21,8 @@
 #include <utility>
 
 #include "varia/core/fixed_size.hpp"
-#include "varia/core/jet.hpp"
-#include "varia/core/kernels.hpp"
+#include "varia/abi/jet.hpp"
+#include "varia/abi/kernels.hpp"
 
 namespace varia {
 

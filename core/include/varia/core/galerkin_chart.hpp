@@ -36,9 +36,9 @@
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/core/galerkin.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/core/mechanics.hpp"
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "varia/core/solve/newton.hpp"
 
 namespace varia {

@@ -17,7 +17,7 @@
 #include <Eigen/Core>
 #include <vector>
 
-#include "varia/core/manifold.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/core/mechanical_field.hpp"
 
 namespace varia {

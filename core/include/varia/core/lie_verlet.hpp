@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/core/mechanics.hpp"
 
 namespace varia {

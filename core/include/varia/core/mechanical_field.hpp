@@ -26,10 +26,10 @@
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/force.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/force.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/core/mechanics.hpp"
-#include "varia/core/one_step.hpp"
+#include "varia/abi/one_step.hpp"
 
 namespace varia {
 

@@ -10,8 +10,8 @@
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/jet.hpp"
-#include "varia/core/lagrangian.hpp"
+#include "varia/abi/jet.hpp"
+#include "varia/abi/lagrangian.hpp"
 
 namespace varia {
 

@@ -11,10 +11,10 @@
 #include <memory>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/core/mechanical_field.hpp"
 #include "varia/core/mechanics.hpp"
-#include "varia/core/one_step.hpp"
+#include "varia/abi/one_step.hpp"
 
 namespace varia {
 

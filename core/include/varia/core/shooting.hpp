@@ -79,12 +79,12 @@
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
-#include "varia/core/force.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/force.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/core/mechanical_field.hpp"
 #include "varia/core/mechanics.hpp"
-#include "varia/core/one_step.hpp"
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/one_step.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "varia/core/solve/newton.hpp"
 #include "varia/core/solve/small_dense.hpp"
 

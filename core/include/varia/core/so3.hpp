@@ -16,7 +16,7 @@
 #include <concepts>
 #include <type_traits>
 
-#include "varia/core/jet.hpp"
+#include "varia/abi/jet.hpp"
 
 namespace varia::so3 {
 

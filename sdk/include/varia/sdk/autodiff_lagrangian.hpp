@@ -36,7 +36,7 @@
 #include <type_traits>
 
 #include "varia/core/explicit_shot.hpp"
-#include "varia/core/lagrangian.hpp"
+#include "varia/abi/lagrangian.hpp"
 #include "varia/core/stormer_verlet.hpp"
 #include "varia/sdk/dual.hpp"
 #include "varia/sdk/jet_tangent.hpp"
@@ -116,7 +116,7 @@ class AutodiffLagrangian : public Lagrangian {
     });
   }
 
-  // The kernels (core/kernels.hpp) with the model inlined: Galerkin's explicit form's
+  // The kernels (abi/kernels.hpp) with the model inlined: Galerkin's explicit form's
   // Stormer-Verlet steps, for m = n and m + n <= kStackVariables (the dual numbers of
   // first_order); the shooting construction's shot, for sizes given at compile time, m = n up to
   // kMaxShotDimension, and explicit methods of up to kMaxShotStages stages (other models take the

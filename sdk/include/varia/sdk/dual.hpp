@@ -14,7 +14,7 @@
 #include <type_traits>
 #include <unsupported/Eigen/AutoDiff>
 
-#include "varia/core/jet.hpp"
+#include "varia/abi/jet.hpp"
 #include "varia/sdk/jet_tangent.hpp"
 
 namespace varia::sdk {

@@ -1,4 +1,4 @@
-// A force (core/include/varia/core/force.hpp), for force plugins: the system's sizes from the
+// A force (abi/include/varia/abi/force.hpp), for force plugins: the system's sizes from the
 // context, the Jacobian's pattern as the plugin declares its entries, and the boundary rule
 // (exceptions become Status messages). docs/writing-effects.md has the walk-through, and
 // varia-conformance checks the Jacobian (sdk/conformance/force.hpp).
@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "varia/core/force.hpp"
+#include "varia/abi/force.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::sdk {

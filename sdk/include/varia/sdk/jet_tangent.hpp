@@ -13,7 +13,7 @@
 #include <cmath>
 #include <compare>
 
-#include "varia/core/jet.hpp"
+#include "varia/abi/jet.hpp"
 
 namespace varia::sdk {
 

@@ -1,6 +1,6 @@
 // A Lie group manifold written once, in the style of manif's minimal API: the plugin author gives
 // the group's operations templated on the scalar, and LieGroupManifold<Group> derives everything
-// the Manifold interface asks of a group (varia/core/manifold.hpp): the natural chart
+// the Manifold interface asks of a group (varia/abi/manifold.hpp): the natural chart
 // q0 exp(xi) and its inverse log(q0^{-1} q) (paper, sec. 2 "Natural charts"), and their first and
 // second derivatives as plain arrays.
 //
@@ -40,8 +40,8 @@
 #include <string>
 #include <vector>
 
-#include "varia/core/jet.hpp"
-#include "varia/core/manifold.hpp"
+#include "varia/abi/jet.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::sdk {

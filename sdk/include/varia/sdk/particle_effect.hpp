@@ -1,4 +1,4 @@
-// An effect over particles (core/include/varia/core/effect.hpp), for effect plugins: the bound
+// An effect over particles (abi/include/varia/abi/effect.hpp), for effect plugins: the bound
 // system (space_dim d, the particles and their masses), the coordinates of the particles an effect
 // names, a dense Hessian pattern over them, and the boundary rule (exceptions become Status
 // messages). A plugin derives from ParticleEffect, chooses its particles in attach() and writes
@@ -12,7 +12,7 @@
 #include <string>
 #include <vector>
 
-#include "varia/core/effect.hpp"
+#include "varia/abi/effect.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::sdk {

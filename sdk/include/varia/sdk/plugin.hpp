@@ -24,7 +24,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia::sdk {
 

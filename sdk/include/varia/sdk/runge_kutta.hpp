@@ -18,7 +18,7 @@
 #include <vector>
 
 #include "varia/core/explicit_shot.hpp"
-#include "varia/core/one_step.hpp"
+#include "varia/abi/one_step.hpp"
 #include "varia/core/solve/newton.hpp"
 #include "varia/sdk/plugin.hpp"
 

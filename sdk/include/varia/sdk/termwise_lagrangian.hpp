@@ -37,8 +37,8 @@
 #include <type_traits>
 #include <vector>
 
-#include "varia/core/lagrangian.hpp"
-#include "varia/core/sparse_pattern.hpp"
+#include "varia/abi/lagrangian.hpp"
+#include "varia/abi/sparse_pattern.hpp"
 #include "varia/sdk/dual.hpp"
 #include "varia/sdk/plugin.hpp"
 

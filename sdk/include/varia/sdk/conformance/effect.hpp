@@ -1,4 +1,4 @@
-// The effect conformance suite (core/effect.hpp), on an effect already bound to a system. Every
+// The effect conformance suite (abi/effect.hpp), on an effect already bound to a system. Every
 // derivative the composite Lagrangian uses is checked against the effect's own values:
 //   - its coordinates are inside q, its Hessian pattern inside k x k (k coordinates);
 //   - at random points x, every evaluate() path gives the same numbers, and the Hessian (its
@@ -17,7 +17,7 @@
 #include <sstream>
 #include <vector>
 
-#include "varia/core/effect.hpp"
+#include "varia/abi/effect.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 #include "varia/sdk/conformance/taylor.hpp"
 

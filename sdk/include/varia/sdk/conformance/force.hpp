@@ -1,4 +1,4 @@
-// The force conformance suite (core/force.hpp). The Jacobian the constructions' Newton solves use
+// The force conformance suite (abi/force.hpp). The Jacobian the constructions' Newton solves use
 // is checked against the force's own values:
 //   - its pattern lies inside the n x (m + n) Jacobian [df/dq, df/dv];
 //   - at random (t, q, v), the force alone equals the force with its Jacobian;
@@ -12,7 +12,7 @@
 #include <random>
 #include <sstream>
 
-#include "varia/core/force.hpp"
+#include "varia/abi/force.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 #include "varia/sdk/conformance/taylor.hpp"
 

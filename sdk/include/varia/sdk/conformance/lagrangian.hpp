@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "varia/core/explicit_shot.hpp"
-#include "varia/core/lagrangian.hpp"
+#include "varia/abi/lagrangian.hpp"
 #include "varia/core/stormer_verlet.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 #include "varia/sdk/conformance/taylor.hpp"

@@ -10,7 +10,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/plugin_object.hpp"
 #include "varia/sdk/plugin.hpp"
 
 namespace varia::sdk::conformance {

@@ -20,7 +20,7 @@
 #include <random>
 #include <vector>
 
-#include "varia/core/manifold.hpp"
+#include "varia/abi/manifold.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 #include "varia/sdk/conformance/taylor.hpp"
 

@@ -10,7 +10,7 @@
 #include <nlohmann/json.hpp>
 #include <vector>
 
-#include "varia/core/quadrature.hpp"
+#include "varia/abi/quadrature.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 
 namespace varia::sdk::conformance {

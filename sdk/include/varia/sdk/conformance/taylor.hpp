@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "varia/core/jet.hpp"
+#include "varia/abi/jet.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 
 namespace varia::sdk::conformance {

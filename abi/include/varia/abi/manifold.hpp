@@ -13,8 +13,8 @@
 // templated on the scalar, and the SDK's adapter (varia/sdk/lie_group.hpp) derives these.
 #pragma once
 
-#include "varia/core/jet.hpp"
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/jet.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia {
 

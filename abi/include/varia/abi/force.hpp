@@ -6,7 +6,7 @@
 
 #include <vector>
 
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia {
 

@@ -5,8 +5,8 @@
 // coordinates and the Hessian of L keeps the sparsity of the effects.
 #pragma once
 
-#include "varia/core/jet.hpp"
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/jet.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia {
 

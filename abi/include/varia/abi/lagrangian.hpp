@@ -3,9 +3,9 @@
 // The gradient is [dL/dq (m), dL/dv (n)]; on a Lie group dL/dq is the gradient in the embedding.
 #pragma once
 
-#include "varia/core/jet.hpp"
-#include "varia/core/kernels.hpp"
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/jet.hpp"
+#include "varia/abi/kernels.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia {
 

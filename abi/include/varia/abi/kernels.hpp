@@ -8,7 +8,7 @@
 // Only plain types here.
 #pragma once
 
-#include "varia/core/jet.hpp"
+#include "varia/abi/jet.hpp"
 
 namespace varia {
 

@@ -2,7 +2,7 @@
 // Rules whose nodes include 0 and 1 with zero weights are allowed (paper, sec. 3).
 #pragma once
 
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia {
 

@@ -4,9 +4,9 @@
 // the shooting construction obtains the exact first and second sensitivities of the propagation.
 #pragma once
 
-#include "varia/core/kernels.hpp"
-#include "varia/core/jet.hpp"
-#include "varia/core/plugin_object.hpp"
+#include "varia/abi/kernels.hpp"
+#include "varia/abi/jet.hpp"
+#include "varia/abi/plugin_object.hpp"
 
 namespace varia {
 
