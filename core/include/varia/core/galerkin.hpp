@@ -109,6 +109,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N>
   double action_for(double h, Order order, bool forced);
   using ActionFunction = double (GalerkinDiscreteLagrangian::*)(double, Order, bool);
+  static ActionFunction action_function(int n);  // action_for<n or Dynamic>
   // The interpolant at quadrature node i into q and v.
   template <int N, int S = Eigen::Dynamic>
   void interpolate(int i, double h, double* q, double* v);
@@ -152,6 +153,8 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N, int R>
   void step_at(const double* q0, const double* p0, double h, double* q1, double* p1);
   using StepFunction = void (GalerkinDiscreteLagrangian::*)(const double*, const double*, double, double*, double*);
+  // step_at<N, R> (node_iteration) or step_at<N, Dynamic> (exact Newton), N and R fixed where small.
+  static StepFunction step_function(int n, int nodes, bool node_iteration);
   void factorize_sparse();
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
