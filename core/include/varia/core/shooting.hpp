@@ -152,6 +152,8 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N>
   void step_at(const double* q0, const double* p0, double h, double* q1, double* p1);
   using StepFunction = void (ShootingDiscreteLagrangian::*)(const double*, const double*, double, double*, double*);
+  // step_at<n> on R^n for n <= 4, step_at<Dynamic> otherwise (shooting_solve.cpp).
+  static StepFunction step_function(int n, bool vector_space);
   StepFunction step_ = nullptr;
   template <int N>
   void shoot(const double* q0, const double* w0, double h);

@@ -1,0 +1,274 @@
+// The shooting construction's equations and their solve (shooting.hpp): the shot's first
+// derivatives, the residual of the target (the momentum for a step, the boundary or lambda for L_d)
+// with its Jacobian in w0, Newton's method on it, the step with its warm start and compensated
+// sums, and L_d; compiled for n <= 4 at fixed sizes, here, once (step_function).
+#include "varia/core/shooting.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "varia/core/compensated.hpp"
+#include "varia/core/fixed_size.hpp"
+
+namespace varia {
+
+namespace {
+
+template <int N>
+using Vector = Eigen::Matrix<double, N, 1>;
+template <int N>
+using Square = Eigen::Matrix<double, N, N>;
+
+}  // namespace
+
+// The shot from (q0, w0): the propagation's values, the first derivatives of G, W and B with
+// lambda and D1 from them (first_derivatives), and, where the solve needs them, Phi's second
+// derivatives (second_derivatives), over the passes (plan_passes; every pass has the same values).
+template <int N>
+void ShootingDiscreteLagrangian::shoot(const double* q0, const double* w0, double h) {
+  bool first = false;  // lambda and D1 known
+  for (const Pass& pass : passes_) {
+    if (!pass.first_order && !second_order_) continue;
+    propagate(q0, w0, h, pass);
+    if (pass.first_order) gather(pass);
+    if (!pass.second_order || !second_order_) continue;
+    if (!first) first_derivatives<N>();
+    first = true;
+    second_derivatives(pass);
+  }
+  if (!first) first_derivatives<N>();
+}
+
+// lambda = B_w^{-T} alpha_w, D1 = alpha_q - B_q^T lambda.
+// With offsets (on a vector space, Type I forms) B_q = I + Bq_, and the momentum change of the
+// step is D1 + D2 = alpha_q - Bq_^T lambda: small terms, each to its own relative precision.
+template <int N>
+void ShootingDiscreteLagrangian::first_derivatives() {
+  const int n = fixed_or<N>(n_);
+  const Eigen::Map<const Square<N>> Bq(Bq_.data(), n, n), Bw(Bw_.data(), n, n);
+  Eigen::Map<Vector<N>> lambda(lambda_.data(), n), D1(D1_.data(), n);
+  BwT_solver_.compute(Bw.transpose());
+  BwT_solver_.solve(Eigen::Map<const Vector<N>>(alpha_.data() + n, n), lambda);
+  D1 = Eigen::Map<const Vector<N>>(alpha_.data(), n);
+  D1.noalias() -= Bq.transpose() * lambda;
+  if (offsets()) {
+    Eigen::Map<Vector<N>>(momentum_change_.data(), n) = D1;
+    D1 -= lambda;
+  }
+}
+
+// residual_ and its Jacobian in w0, jacobian_, for the target:
+//   momentum: dD1/dw0 = Phi_qw - B_q^T B_w^{-T} Phi_ww;
+//   boundary: B_w;
+//   lambda:   dlambda/dw0 = B_w^{-T} Phi_ww.
+template <int N>
+void ShootingDiscreteLagrangian::residual(Target target, const double* data) {
+  const int n = fixed_or<N>(n_);
+  const Eigen::Map<const Vector<N>> given(data, n), D1(D1_.data(), n), lambda(lambda_.data(), n);
+  const Eigen::Map<const Square<N>> Bq(Bq_.data(), n, n);
+  Eigen::Map<Vector<N>> F(residual_.data(), n);
+  Eigen::Map<Square<N>> jacobian(jacobian_.data(), n, n), lambda_jacobian(lambda_jacobian_.data(), n, n);
+  const auto phi_ww = phi_.template block<N, N>(n, n, n, n);
+  switch (target) {
+    case Target::momentum:
+      F = D1;
+      if (type_2()) F -= given;
+      else F += given;
+      BwT_solver_.solve(phi_ww, lambda_jacobian);
+      jacobian = phi_.template block<N, N>(0, n, n, n);
+      jacobian.noalias() -= Bq.transpose() * lambda_jacobian;
+      if (offsets()) jacobian -= lambda_jacobian;
+      break;
+    case Target::boundary:
+      for (int r = 0; r < n; ++r) F[r] = boundary_[r].value - given[r];
+      jacobian = Eigen::Map<const Square<N>>(Bw_.data(), n, n);
+      break;
+    case Target::lambda:
+      F = lambda - given;
+      BwT_solver_.solve(phi_ww, jacobian);
+      break;
+  }
+}
+
+// The shooting equations in w0 (residual(): the target's), as a system for NewtonSolver
+// (solve/newton.hpp), with the exact Jacobian.
+template <int N>
+struct ShootingDiscreteLagrangian::Equations {
+  ShootingDiscreteLagrangian& s;
+  const double* q0;
+  double h;
+  Target target;
+  const double* data;
+  int n = fixed_or<N>(s.n_);
+
+  int size() const { return s.n_; }
+  // F's round-off yardstick: the largest of its terms, the given data and D1 (momentum) or B.
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
+    s.shoot<N>(q0, s.w_.data(), h);
+    s.residual<N>(target, data);
+    F = Eigen::Map<const Vector<N>>(s.residual_.data(), n);
+    double yardstick = Eigen::Map<const Vector<N>>(data, n).template lpNorm<Eigen::Infinity>();
+    if (target == Target::momentum)
+      return std::max(yardstick, Eigen::Map<const Vector<N>>(s.D1_.data(), n).template lpNorm<Eigen::Infinity>());
+    for (int r = 0; r < n; ++r) yardstick = std::max(yardstick, std::abs(s.boundary_[r].value));
+    return yardstick;
+  }
+  void factorize() { s.jacobian_solver_.compute(Eigen::Map<const Square<N>>(s.jacobian_.data(), n, n)); }
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) {
+    Eigen::Map<Vector<N>> x(update.data(), n);
+    s.jacobian_solver_.solve(Eigen::Map<const Vector<N>>(F.data(), n), x);
+  }
+  double apply(const Eigen::VectorXd& update) {
+    Eigen::Map<Vector<N>> w(s.w_.data(), n);
+    w -= Eigen::Map<const Vector<N>>(update.data(), n);
+    return w.template lpNorm<Eigen::Infinity>();
+  }
+  // The step's outcome at the updated w0, to first order from the last shot (no propagation):
+  // the state's values by their w0-derivatives, lambda by dlambda/dw0 = B_w^{-T} Phi_ww, the
+  // momentum change by dD1/dw0 + dlambda/dw0, the residual by its Jacobian.
+  // On a Lie group the point is the state's (one pass, whose variables are x = (eta, w0)); on a
+  // vector space it is read from B.
+  void finish(const Eigen::VectorXd& update_vector) {
+    if (target != Target::momentum) return;
+    const Eigen::Map<const Vector<N>> update(update_vector.data(), n);
+    if (!s.manifold_.is_vector_space())
+      for (int r = 0; r < s.m_; ++r)
+        if (!s.state_[r].constant()) s.state_[r].value -= s.state_[r].gradient.tail(n).dot(update);
+    const Eigen::Map<const Square<N>> Bw(s.Bw_.data(), n, n), jacobian(s.jacobian_.data(), n, n),
+        lambda_jacobian(s.lambda_jacobian_.data(), n, n);
+    for (int r = 0; r < n; ++r) s.boundary_[r].value -= Bw.row(r).dot(update);
+    Eigen::Map<Vector<N>>(s.lambda_.data(), n).noalias() -= lambda_jacobian * update;
+    if (s.offsets()) {
+      Eigen::Map<Vector<N>> change(s.momentum_change_.data(), n);
+      change.noalias() -= jacobian * update;
+      change.noalias() -= lambda_jacobian * update;
+    }
+    Eigen::Map<Vector<N>>(s.residual_.data(), n).noalias() -= jacobian * update;
+  }
+};
+
+// Newton's method with the exact Jacobian on w0 (starting from w_); the last shot stays in the
+// workspace for the outputs, brought to the solution to first order (Equations::finish).
+template <int N>
+void ShootingDiscreteLagrangian::solve(const double* q0, double h, Target target,
+                                       const double* data) {
+  Equations<N> equations{*this, q0, h, target, data};
+  second_order_ = target != Target::boundary;
+  require_converged(solver_.solve(equations, statistics_), "the shooting equations");
+}
+
+template <int N>
+void ShootingDiscreteLagrangian::step_at(const double* q0, const double* p0, double h, double* q1, double* p1) {
+  const int n = fixed_or<N>(n_), m = fixed_or<N>(m_);  // N is fixed on R^n only, where m = n
+  const Eigen::Map<const Vector<N>> start(q0, m), momentum(p0, n);
+  Eigen::Map<Vector<N>> end_q(end_q_.data(), m), end_p(end_p_.data(), n), guess(guess_.data(), n);
+  const bool continues = continuing_ && end_q == start && end_p == momentum;
+  if (form_ == ShootingForm::lagrangian && field_->constant_mass())
+    guess.noalias() = Eigen::Map<const Square<N>>(field_->inverse_mass().data(), n, n) * momentum;
+  else if (form_ == ShootingForm::lagrangian) mechanical_->velocity_of(q0, p0, guess_.data());
+  else guess = momentum;
+  warm_start<N>(continues && h == previous_h_);
+  target_is_end_ = true;
+  solve<N>(q0, h, Target::momentum, p0);
+  record_correction<N>(h);
+  Eigen::Map<Vector<N>> p(p1, n);
+  if (offsets()) {
+    Eigen::Map<Vector<N>> carry_q(carry_q_.data(), n), carry_p(carry_p_.data(), n),
+        offset(offset_.data(), n), change(momentum_change_.data(), n);
+    if (!continues) {
+      carry_q.setZero();
+      carry_p.setZero();
+    }
+    for (int r = 0; r < n; ++r) offset[r] = boundary_[r].value;
+    change -= Eigen::Map<const Vector<N>>(residual_.data(), n);
+    end_q = start;
+    compensated_add(end_q, offset, carry_q);
+    end_p = momentum;
+    compensated_add(end_p, change, carry_p);
+    Eigen::Map<Vector<N>>(q1, n) = end_q;
+    p = end_p;
+  } else {
+    if (type_2()) {
+      for (int r = 0; r < n; ++r) p[r] = boundary_[r].value;
+      Eigen::Map<Vector<N>>(q1, n) = Eigen::Map<const Vector<N>>(lambda_.data(), n);
+    } else {
+      for (int r = 0; r < m; ++r) q1[r] = state_[r].value;
+      p = Eigen::Map<const Vector<N>>(lambda_.data(), n);  // with forces p1 = D2 L_d + f_d^+
+    }
+    end_q = Eigen::Map<const Vector<N>>(q1, m);
+    end_p = p;
+  }
+  continuing_ = true;
+}
+
+// The warm start: w0 = guess + c, the correction c = w0 - guess of the step extrapolated from the
+// last steps' (while the steps continue one another at the same h) by the polynomial through up to
+// three of them. The correction is a smooth function of the state along the motion, of the
+// size of the method's local error (the inverse Legendre transform is exact for the exact flow),
+// so that the first shot's residual is of that size times h^k, k the corrections used. With the
+// guess alone the first residual of the pendulum at h = 0.005 (SVIRK4) was 1e-12 and every step
+// took two shots; from the extrapolation the first update is at round-off and the step one shot
+// (Newton's stopping rule, solve/newton.hpp: the error left is of the update's square).
+template <int N>
+void ShootingDiscreteLagrangian::warm_start(bool continues) {
+  if (!continues) corrections_ = 0;
+  static constexpr double kExtrapolation[3][3] = {{1.0, 0.0, 0.0}, {2.0, -1.0, 0.0}, {3.0, -3.0, 1.0}};
+  const int n = fixed_or<N>(n_);
+  Eigen::Map<Vector<N>> w(w_.data(), n);
+  w = Eigen::Map<const Vector<N>>(guess_.data(), n);
+  if (corrections_ == 0) return;
+  const double* c = kExtrapolation[corrections_ - 1];
+  for (int k = 0; k < corrections_; ++k) w += c[k] * Eigen::Map<const Vector<N>>(&corrections_history_(0, k), n);
+}
+
+// The converged step's correction w0 - guess joins the history (newest first).
+template <int N>
+void ShootingDiscreteLagrangian::record_correction(double h) {
+  const int n = fixed_or<N>(n_);
+  const auto correction = [&](int k) { return Eigen::Map<Vector<N>>(&corrections_history_(0, k), n); };
+  for (int k = kCorrections - 1; k > 0; --k) correction(k) = correction(k - 1);
+  correction(0) = Eigen::Map<const Vector<N>>(w_.data(), n) - Eigen::Map<const Vector<N>>(guess_.data(), n);
+  corrections_ = std::min(corrections_ + 1, kCorrections);
+  previous_h_ = h;
+}
+
+// From the velocity local(q0, q1)/h of the chart's straight line (times M for a momentum).
+void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, double h,
+                                          double* Ld, double* D1, double* D2) {
+  forced_ = false;  // L_d alone: the forces are not part of it
+  check(manifold_, manifold_.local(q0, q1, w_.data()), "manifold chart");
+  w_ /= h;
+  if (form_ != ShootingForm::lagrangian) {  // p0's guess: the momentum of that velocity at q0
+    v_values_ = w_;
+    mechanical_->momentum(q0, v_values_.data(), w_.data());
+  }
+  target_is_end_ = false;
+  std::copy_n(q1, m_, target_.begin());
+  // On a vector space B = q^n - q0 against q1 - q0 (type-2: lambda against q1); through the chart
+  // at q1, B = local(q1, q^n) against 0.
+  if (type_2()) {
+    solve<Eigen::Dynamic>(q0, h, Target::lambda, q1);
+  } else if (offsets()) {
+    offset_ = Eigen::Map<const Eigen::VectorXd>(q1, n_) - Eigen::Map<const Eigen::VectorXd>(q0, n_);
+    solve<Eigen::Dynamic>(q0, h, Target::boundary, offset_.data());
+  } else {
+    solve<Eigen::Dynamic>(q0, h, Target::boundary, zero_.data());
+  }
+  double p1_q1 = 0.0;
+  for (int r = 0; r < n_; ++r) p1_q1 += boundary_[r].value * lambda_[r];
+  if (Ld != nullptr) *Ld = type_2() ? p1_q1 - generating_.value : generating_.value;
+  if (D1 != nullptr) Eigen::Map<Eigen::VectorXd>(D1, n_) = type_2() ? -D1_ : D1_;
+  if (D2 == nullptr) return;
+  Eigen::Map<Eigen::VectorXd> d2(D2, n_);
+  if (type_2())
+    for (int r = 0; r < n_; ++r) d2[r] = boundary_[r].value;
+  else
+    d2 = lambda_;
+}
+
+ShootingDiscreteLagrangian::StepFunction ShootingDiscreteLagrangian::step_function(int n, bool vector_space) {
+  if (!vector_space) return &ShootingDiscreteLagrangian::step_at<Eigen::Dynamic>;
+  return for_dimension(n, [](auto N) -> StepFunction { return &ShootingDiscreteLagrangian::step_at<decltype(N)::value>; });
+}
+
+}  // namespace varia
