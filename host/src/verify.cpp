@@ -101,6 +101,46 @@ auto within(const char* property, double h, F&& measure) {
   }
 }
 
+// A defect's values at the step sizes where it could be measured, and the noise they were measured
+// against. A numerical failure at one step size (its equations have no solution there, or a step
+// does not converge) drops that step size, named in `dropped`, as the order fits drop diverged
+// runs: the others still measure the defect.
+struct DefectValues {
+  std::vector<double> h, values;
+  double noise = 0.0;
+  std::string dropped;
+};
+
+// measure(h) at each step size of hs (within: a signal stops it between two).
+template <class F>
+DefectValues defect_values(const char* property, const std::vector<double>& hs, double noise, F&& measure) {
+  DefectValues d;
+  d.noise = noise;
+  for (double h : hs) {
+    try {
+      d.values.push_back(within(property, h, [&] { return measure(h, d.noise); }));
+      d.h.push_back(h);
+    } catch (const NumericalFailure& e) {
+      d.dropped += fmt::format("{}{}", d.dropped.empty() ? "" : "; ", e.what());
+    }
+  }
+  return d;
+}
+
+// The defect's scaling (defect_check) where it was measured at two step sizes or more; else not
+// measured, with the failures that dropped the others.
+PropertyCheck defect_check(const char* name, json predicted, const DefectValues& d, const std::string& how) {
+  if (d.h.size() < 2) {
+    PropertyCheck c = check_of(name, std::move(predicted));
+    c.note = fmt::format("not measured: a defect's scaling takes two step sizes, and {} had a solution ({})",
+                         d.h.size(), d.dropped);
+    return c;
+  }
+  PropertyCheck c = defect_check(name, std::move(predicted), defect_scaling(d.h, d.values, d.noise), how);
+  if (!d.dropped.empty()) c.note += "; step sizes dropped, a numerical failure there: " + d.dropped;
+  return c;
+}
+
 std::vector<double> velocity_of(Context& x, const double* q, const double* p, std::vector<double> guess) {
   x.lagrangian.inverse_legendre(q, p, guess.data(), x.scene.solver);
   return guess;
@@ -145,27 +185,26 @@ double map_symmetry_residual(Context& x, double h) {
 constexpr double kSpread = 100.0, kSolverSpread = 10.0;
 
 template <class F>
-DefectScaling ld_defect(Context& x, const char* property, const std::vector<double>& hs, F&& residual) {
+DefectValues ld_defect(Context& x, const char* property, const std::vector<double>& hs, F&& residual) {
   const auto v = initial_velocity(x);
-  std::vector<double> values;
-  double noise = kSpread * kEpsilon;
-  for (double h : hs)
-    values.push_back(within(property, h, [&] {
-      const auto pairs = sample_pairs(*x.a.manifold, x.a.q0.data(), v.data(), h, kPairs);
-      noise = std::max({noise, kSpread * round_off_of(*x.a.discrete_lagrangian, *x.a.manifold, pairs, h),
-                        kSolverSpread * solver_noise_of(*x.a.discrete_lagrangian, *x.a.manifold, pairs, h, x.scene.solver.tolerance)});
-      return residual(pairs, h);
-    }));
-  return defect_scaling(hs, values, noise);
+  return defect_values(property, hs, kSpread * kEpsilon, [&](double h, double& noise) {
+    const auto pairs = sample_pairs(*x.a.manifold, x.a.q0.data(), v.data(), h, kPairs);
+    const double here = std::max(kSpread * round_off_of(*x.a.discrete_lagrangian, *x.a.manifold, pairs, h),
+                                 kSolverSpread * solver_noise_of(*x.a.discrete_lagrangian, *x.a.manifold, pairs, h,
+                                                                 x.scene.solver.tolerance));
+    const double value = residual(pairs, h);
+    noise = std::max(noise, here);
+    return value;
+  });
 }
 
 PropertyCheck self_adjoint(Context& x) {
   const json predicted = prediction(x.predictions.self_adjoint);
   const auto hs = steps_of(x, {2, 1, 0, -1});
   if (x.a.discrete_lagrangian == nullptr) {
-    std::vector<double> values;
-    for (double h : hs) values.push_back(within("self_adjoint", h, [&] { return map_symmetry_residual(x, h); }));
-    return defect_check("self_adjoint", predicted, defect_scaling(hs, values, kNoiseSpread * kEpsilon),
+    return defect_check("self_adjoint", predicted,
+                        defect_values("self_adjoint", hs, kNoiseSpread * kEpsilon,
+                                      [&](double h, double&) { return map_symmetry_residual(x, h); }),
                         "|Phi_{-h}(Phi_h(x)) - x| / (1 + |x|), one step from the initial state");
   }
   return defect_check("self_adjoint", predicted,
@@ -560,18 +599,13 @@ Eigen::VectorXd difference_steps(Context& x) {
 }
 
 PropertyCheck symplectic(Context& x) {
-  std::vector<double> values;
-  double noise = kNoiseSpread * kEpsilon;
-  const auto hs = steps_of(x, {1, 0, -1});
   const Eigen::VectorXd steps = difference_steps(x);
-  for (double h : hs) {
-    const auto d = within("symplectic", h, [&] {
-      return symplecticity_defect(*x.a.map, *x.a.manifold, x.a.q0.data(), x.a.p0.data(), h, steps);
-    });
-    values.push_back(d.defect);
-    noise = std::max(noise, 10 * d.noise);
-  }
-  return defect_check("symplectic", prediction(x.predictions.symplectic), defect_scaling(hs, values, noise),
+  const auto d = defect_values("symplectic", steps_of(x, {1, 0, -1}), kNoiseSpread * kEpsilon, [&](double h, double& noise) {
+    const auto defect = symplecticity_defect(*x.a.map, *x.a.manifold, x.a.q0.data(), x.a.p0.data(), h, steps);
+    noise = std::max(noise, 10 * defect.noise);
+    return defect.defect;
+  });
+  return defect_check("symplectic", prediction(x.predictions.symplectic), d,
                       "||M^T J M - J||max in canonical chart coordinates, each in its own scale (positions in the "
                       "state's length, momenta in mass times its speed), M by Richardson-extrapolated central "
                       "differences of a thousandth of those scales (noise: 10 times their change with the "
