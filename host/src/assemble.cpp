@@ -130,6 +130,22 @@ void check_momentum_size(const Lagrangian& lagrangian, int dim) {
                       lagrangian.origin());
 }
 
+void check_declared_sizes(const Manifold& manifold) {
+  const int m = manifold.point_size(), n = manifold.dim();
+  if (n >= 1 && n <= m) return;
+  throw PluginFault(fmt::format("the manifold declares point size {} and dimension {}; a manifold embedded in "
+                                "R^(point size) has a dimension from 1 to its point size",
+                                m, n),
+                    manifold.origin());
+}
+
+void check_declared_sizes(const Lagrangian& lagrangian) {
+  const int m = lagrangian.position_size(), n = lagrangian.velocity_size();
+  if (m >= 1 && n >= 1) return;
+  throw PluginFault(fmt::format("the Lagrangian declares {} position and {} velocity numbers; each is at least 1", m, n),
+                    lagrangian.origin());
+}
+
 void check_hessian_pattern(const Lagrangian& lagrangian) {
   const int *rows = nullptr, *cols = nullptr;
   const int entries = lagrangian.hessian_pattern(&rows, &cols);
@@ -154,9 +170,11 @@ Assembly assemble(const Scene& scene, Registry& registry) {
   Assembly a;
   // The manifold first: its sizes go into the context of the others (Rn reads its "dim").
   a.manifold = make_part<Manifold>(registry, scene.manifold, sdk::Context{scene.manifold.type, 0, 0});
+  check_declared_sizes(*a.manifold);
   check_structure_served(scene, *a.manifold);
   check_initial_state(scene, *a.manifold, scene.manifold.type);
   a.lagrangian = lagrangian(scene, registry, *a.manifold);
+  check_declared_sizes(*a.lagrangian);
   check_lagrangian_fits(scene, *a.lagrangian, *a.manifold);
   check_momentum_size(*a.lagrangian, a.manifold->dim());
   check_hessian_pattern(*a.lagrangian);

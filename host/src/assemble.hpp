@@ -46,6 +46,13 @@ bool has_exact_solution(const Assembly& assembly);
 // than a scene asking for more memory than the machine has. Called by assemble().
 void check_momentum_size(const Lagrangian& lagrangian, int dim);
 
+// Sizes no scene can cause: a manifold of dimension < 1 or above its point size (it is embedded in
+// R^point_size), a Lagrangian of fewer than one position or velocity number. PluginFault naming
+// the plugin; a size that merely differs from the scene's or the manifold's is the scene's
+// mismatch (InputError: Rn's dim comes from the scene). Called by assemble().
+void check_declared_sizes(const Manifold& manifold);
+void check_declared_sizes(const Lagrangian& lagrangian);
+
 // A sparse Hessian pattern (Lagrangian::hessian_pattern) indexes the Hessian over (q, v) that the
 // evaluator and the constructions write through it: every row and column must lie within it, else
 // PluginFault from the Lagrangian, naming its plugin. Called by assemble().

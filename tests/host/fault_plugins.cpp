@@ -452,6 +452,54 @@ TEST_CASE("a Lagrangian declaring a momentum map larger than any group acting on
                    "'huge-momentum' (/plugins/lagrangian_huge_momentum.so)");
 }
 
+// A manifold and a Lagrangian declaring sizes no scene can cause (a dimension above the point size,
+// no velocity numbers), made here, their origin a registry's record.
+class WiderThanItsPoints final : public Manifold {
+ public:
+  int point_size() const noexcept override { return 2; }
+  int dim() const noexcept override { return 3; }
+  ManifoldStructure structure() const noexcept override { return ManifoldStructure::vector_space; }
+  Status retract(const double*, const double*, double*) noexcept override { return nullptr; }
+  Status local(const double*, const double*, double*) noexcept override { return nullptr; }
+  bool contains(const double*, char*, int) noexcept override { return true; }
+};
+class NoVelocities final : public Lagrangian {
+ public:
+  int position_size() const noexcept override { return 1; }
+  int velocity_size() const noexcept override { return -4; }
+  Status evaluate(const double*, const double*, double*, double*, double*) noexcept override { return nullptr; }
+};
+
+// The message the check gives inside the registry's naming of faults, as every command's assembly does.
+template <class F>
+std::string fault_of(F&& check) {
+  try {
+    host::with_registry({}, [&](host::Registry&) {
+      check();
+      return 0;
+    });
+  } catch (const PluginFault& e) {
+    return e.what();
+  }
+  return "(nothing thrown)";
+}
+
+TEST_CASE("a manifold or a Lagrangian declaring sizes no scene can cause is a plugin fault naming its file (issue "
+          "#43: they were reported as the scene's mismatch, exit 2)") {
+  const host::PluginRecord manifold_record{"/plugins/manifold_wide.so", "manifold", "wide", "0.0.1", {}, {}, {}};
+  const host::PluginRecord lagrangian_record{"/plugins/lagrangian_still.so", "lagrangian", "still", "0.0.1", {}, {}, {}};
+  WiderThanItsPoints manifold;
+  manifold.set_origin(&manifold_record);
+  NoVelocities lagrangian;
+  lagrangian.set_origin(&lagrangian_record);
+  CHECK(fault_of([&] { host::check_declared_sizes(manifold); }) ==
+        "the manifold declares point size 2 and dimension 3; a manifold embedded in R^(point size) has a dimension "
+        "from 1 to its point size; from manifold 'wide' (/plugins/manifold_wide.so)");
+  CHECK(fault_of([&] { host::check_declared_sizes(lagrangian); }) ==
+        "the Lagrangian declares 1 position and -4 velocity numbers; each is at least 1; from lagrangian 'still' "
+        "(/plugins/lagrangian_still.so)");
+}
+
 // A manifold whose structure no construction serves yet (a homogeneous space, S2:
 // tests/fault_plugins/unserved_sphere.cpp) is refused once, at /system/manifold, by validate and
 // for every construction, before anything else is made of it; it is not taken for a Lie group.
