@@ -43,24 +43,17 @@ class MorseChain final : public varia::sdk::TermwiseLagrangian {
   })json";
 
   MorseChain(const nlohmann::json& parameters, const varia::sdk::Context& context)
-      : TermwiseLagrangian(dimension(context), dimension(context)),
-        mass_(varia::plugins::positive_parameter(parameters, "mass", 1.0)) {
+      : TermwiseLagrangian(dimension(context), dimension(context)) {
     const varia::plugins::MorseBond bond{varia::plugins::positive_parameter(parameters, "depth", 1.0),
                                          varia::plugins::positive_parameter(parameters, "range", 1.0),
                                          varia::plugins::positive_parameter(parameters, "rest_length", 1.0)};
-    const double m = mass_;
+    const double m = varia::plugins::positive_parameter(parameters, "mass", 1.0);
     for (int i = 0; i < velocity_size(); ++i)
       add_term([m]<class T>(const varia::sdk::TermVec<T, 1>& x) -> T { return 0.5 * m * x(0) * x(0); }, {velocity(i)});
     for (int i = 0; i + 3 < position_size(); i += 2)
       add_term([bond]<class T>(const varia::sdk::TermVec<T, 4>& x) -> T { return -bond(x(0), x(1), x(2), x(3)); },
                {position(i), position(i + 1), position(i + 2), position(i + 3)});
   }
-
-  bool constant_mass_matrix(double* mass) const noexcept override {
-    varia::plugins::write_scaled_identity(mass, velocity_size(), mass_);
-    return true;
-  }
-  bool has_constant_mass_matrix() const noexcept override { return true; }
 
  private:
   static int dimension(const varia::sdk::Context& context) {
@@ -70,8 +63,6 @@ class MorseChain final : public varia::sdk::TermwiseLagrangian {
                                   std::to_string(context.dim));
     return context.dim;
   }
-
-  double mass_;
 };
 
 }  // namespace

@@ -135,8 +135,10 @@ struct SeparablePendulum : Pendulum {
 // n unit masses on a line, neighbours joined by anharmonic springs (V = d^2/2 + d^4/4, d the
 // stretch past length 1), written term-wise: a sparse Lagrangian (the Hessian's pattern from the
 // terms). Declared (has_constant_mass_matrix) or not, to compare the explicit form with Newton.
+// Its constant mass matrix is read off the terms (TermwiseLagrangian), or refused (explicit_forms
+// false: the implicit forms' Newton solves).
 struct SparseChain : sdk::TermwiseLagrangian {
-  SparseChain(int n, bool declared) : TermwiseLagrangian(n, n), declared_(declared) {
+  SparseChain(int n, bool explicit_forms) : TermwiseLagrangian(n, n), explicit_forms_(explicit_forms) {
     for (int i = 0; i < n; ++i)
       add_term([]<class T>(const sdk::TermVec<T, 1>& x) -> T { return 0.5 * x(0) * x(0); }, {velocity(i)});
     for (int i = 0; i + 1 < n; ++i)
@@ -147,10 +149,12 @@ struct SparseChain : sdk::TermwiseLagrangian {
           },
           {position(i), position(i + 1)});
   }
-  bool has_constant_mass_matrix() const noexcept override { return declared_; }
+  bool has_constant_mass_matrix() const noexcept override {
+    return explicit_forms_ && TermwiseLagrangian::has_constant_mass_matrix();
+  }
 
  private:
-  bool declared_;
+  bool explicit_forms_;
 };
 
 }  // namespace varia::testing

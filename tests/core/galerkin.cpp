@@ -109,10 +109,12 @@ TEST_CASE("galerkin explicit form for a constant mass matrix agrees with the New
   CHECK(newton.solver_statistics().max_iterations >= 1);
 }
 
-TEST_CASE("galerkin explicit form for a sparse Lagrangian with a constant mass matrix: the Newton solve's steps, no Newton iteration (issue #18)") {
+TEST_CASE("galerkin explicit form for a sparse Lagrangian with a constant mass matrix, read off its terms without a "
+          "declaration: the Newton solve's steps, no Newton iteration (issues #18 and #39)") {
   const int n = 6;
   FlatSpace space(n);
   SparseChain declared(n, true), undeclared(n, false);
+  CHECK(declared.has_constant_mass_matrix());
   auto rule = trapezoid();
   GalerkinDiscreteLagrangian newton(space, undeclared, rule, equispaced_control_times(1), {});
   GalerkinDiscreteLagrangian direct(space, declared, rule, equispaced_control_times(1), {});

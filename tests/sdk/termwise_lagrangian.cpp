@@ -166,3 +166,36 @@ TEST_CASE("a term naming a number outside (q, v) is refused when it is added, na
     CHECK(std::string(e.what()) == "a term names velocity 5 of 5");
   }
 }
+
+namespace {
+
+// L = sum_i (1 + i) v_i^2 / 2 + 0.25 v_0 v_1 + sum_i c_i sin(q_i) q_{i+1}^2: a constant mass matrix
+// (with a coupling of v_0 and v_1), declared nowhere; `branch` adds a term that branches on q_0.
+class Separable final : public varia::sdk::TermwiseLagrangian {
+ public:
+  explicit Separable(bool branch = false) : TermwiseLagrangian(kSize, kSize) {
+    for (int i = 0; i < kSize; ++i) add_term(Kinetic{1.0 + i}, {velocity(i)});
+    add_term([]<class T>(const TermVec<T, 2>& x) -> T { return 0.25 * x(0) * x(1); }, {velocity(0), velocity(1)});
+    for (int i = 0; i + 1 < kSize; ++i) add_term(Coupling{0.3 + 0.1 * i}, {position(i), position(i + 1)});
+    if (branch) add_term([]<class T>(const TermVec<T, 1>& x) -> T { return x(0) > 0.0 ? x(0) : -x(0); }, {position(0)});
+  }
+};
+
+}  // namespace
+
+TEST_CASE("a term-wise Lagrangian's constant mass matrix is read off its terms, declared nowhere (issue #39: a "
+          "term-wise model that did not declare it stepped Stormer-Verlet by Newton's method)") {
+  Separable separable;
+  REQUIRE(separable.has_constant_mass_matrix());
+  MatrixXd mass(kSize, kSize), expected = MatrixXd::Zero(kSize, kSize);
+  REQUIRE(separable.constant_mass_matrix(mass.data()));
+  for (int i = 0; i < kSize; ++i) expected(i, i) = 1.0 + i;
+  expected(0, 1) = expected(1, 0) = 0.25;
+  CHECK((mass - expected).cwiseAbs().maxCoeff() < 1e-15);
+  // A mass depending on q (Inertia in Sum), or a term that branches on q: not read as constant.
+  Sum varying;
+  CHECK_FALSE(varying.has_constant_mass_matrix());
+  CHECK_FALSE(varying.constant_mass_matrix(mass.data()));
+  Separable branching(true);
+  CHECK_FALSE(branching.has_constant_mass_matrix());
+}

@@ -26,12 +26,18 @@
 // term's body, which would dangle (the SDK refuses such a term at compile time). add_term keeps a
 // copy of the term. docs/writing-plugins.md has a worked 60-DOF example
 // (plugins/lagrangian/morse_chain.cpp).
+// Where every term is of the form 1/2 v^T M v - V(q) with M constant (read off each term's
+// expression, velocity_structure.hpp: a sum of such terms is one), the Lagrangian has a constant mass
+// matrix without declaring it (has_constant_mass_matrix, constant_mass_matrix: M is the Hessian's
+// vv block, the same at every point), and the constructions' explicit forms serve it.
 #pragma once
 
 #include <Eigen/Core>
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <type_traits>
@@ -41,6 +47,7 @@
 #include "varia/abi/sparse_pattern.hpp"
 #include "varia/sdk/dual.hpp"
 #include "varia/sdk/plugin.hpp"
+#include "varia/sdk/velocity_structure.hpp"
 
 namespace varia::sdk {
 
@@ -73,6 +80,31 @@ class TermwiseLagrangian : public Lagrangian {
   }
   int hessian_pattern(const int** rows, const int** cols) const noexcept final {
     return pattern_.entries(rows, cols);
+  }
+
+  // Read off the terms (a model may still override both, to give M itself or to refuse the
+  // explicit forms; the conformance suite checks a declared M against the Hessian).
+  bool has_constant_mass_matrix() const noexcept override {
+    if (!constant_mass_form_)
+      constant_mass_form_ = std::all_of(groups_.begin(), groups_.end(),
+                                        [&](const auto& group) { return group->constant_mass_form(m_); });
+    return *constant_mass_form_;
+  }
+  bool constant_mass_matrix(double* mass) const noexcept override {
+    if (!has_constant_mass_matrix()) return false;
+    std::vector<double> q(m_, 0.5), v(n_, 0.0), hessian(pattern_.size());
+    // evaluate() keeps no state between calls but the workspace it overwrites.
+    if (const_cast<TermwiseLagrangian*>(this)->evaluate(q.data(), v.data(), nullptr, nullptr, hessian.data()) != nullptr)
+      return false;
+    std::fill(mass, mass + n_ * n_, 0.0);
+    const int *rows = nullptr, *cols = nullptr;
+    const int entries = pattern_.entries(&rows, &cols);
+    for (int e = 0; e < entries; ++e)
+      if (rows[e] >= m_ && cols[e] >= m_) {
+        if (!std::isfinite(hessian[e])) return false;
+        mass[(cols[e] - m_) * n_ + rows[e] - m_] = hessian[e];
+      }
+    return true;
   }
 
   bool evaluates_at_jets() const noexcept final { return true; }
@@ -113,6 +145,7 @@ class TermwiseLagrangian : public Lagrangian {
       for (int i = 0; i < K; ++i) slots[j * K + i] = pattern_.slot(at[i], at[j]);
     group<Term, K>().add(term, at, slots);
     ++terms_;
+    constant_mass_form_.reset();
   }
 
   std::string error_;  // the message of the last failed call (see guarded)
@@ -126,6 +159,8 @@ class TermwiseLagrangian : public Lagrangian {
     virtual void gradient(const double* z, double& L, double* gradient) const = 0;
     virtual void hessian(const double* z, double& L, double* gradient, double* hessian) const = 0;
     virtual void gradient_jet(const Jet2* z, Jet2& L, Jet2* gradient) const = 0;
+    // Whether every term is 1/2 v^T M v - V(q) with M constant (z's first m numbers are q).
+    virtual bool constant_mass_form(int m) const = 0;
   };
   template <class Term, int K>
   class Terms final : public Group {
@@ -164,6 +199,15 @@ class TermwiseLagrangian : public Lagrangian {
     }
     void gradient_jet(const Jet2* z, Jet2& L, Jet2* gradient) const override {
       first_order<JetDual<K>>(z, L, gradient);
+    }
+    bool constant_mass_form(int m) const override {
+      for (std::size_t t = 0; t < terms_.size(); ++t) {
+        TermVec<VelocityStructure, K> x;
+        for (int i = 0; i < K; ++i)
+          x(i) = indices_[t][i] < m ? VelocityStructure::position(0.5) : VelocityStructure::velocity(0.5);
+        if (!constant_mass_form_of([&] { return call(t, x); })) return false;
+      }
+      return true;
     }
 
    private:
@@ -213,6 +257,7 @@ class TermwiseLagrangian : public Lagrangian {
 
   int m_, n_;
   int terms_ = 0;
+  mutable std::optional<bool> constant_mass_form_;
   SparsePattern pattern_;
   std::vector<std::unique_ptr<Group>> groups_;
   std::vector<double> z_;  // workspace, sized once

@@ -170,21 +170,30 @@ struct ScalarBinaryOpTraits<double, varia::sdk::VelocityStructure, BinaryOp> {
 
 namespace varia::sdk {
 
-// Whether lagrangian(q, v), a model written for any scalar (called here with Vec<VelocityStructure>
-// of m and n numbers), is 1/2 v^T M v - V(q) with M constant, read off its expression. False where
-// the model branches on a value of (q, v) or throws.
-template <class Model>
-bool has_constant_mass_form(int m, int n, const Model& lagrangian) {
+// Whether the expression that evaluate() computes from inputs of VelocityStructure (seeded by the
+// caller: position() for q, velocity() for v) is 1/2 v^T M v - V(q) with M constant. False where it
+// branches on a value of (q, v) or throws.
+template <class F>
+bool constant_mass_form_of(F&& evaluate) {
   try {
-    Vec<VelocityStructure> q(m), v(n);
-    for (int i = 0; i < m; ++i) q(i) = VelocityStructure::position(0.5);
-    for (int i = 0; i < n; ++i) v(i) = VelocityStructure::velocity(0.5);
     VelocityStructure::branched() = false;
-    const VelocityStructure L = lagrangian(q, v);
+    const VelocityStructure L = evaluate();
     return L.constant_mass_form() && !VelocityStructure::branched();
   } catch (...) {
     return false;
   }
+}
+
+// Whether lagrangian(q, v), a model written for any scalar (called here with Vec<VelocityStructure>
+// of m and n numbers), is 1/2 v^T M v - V(q) with M constant, read off its expression.
+template <class Model>
+bool has_constant_mass_form(int m, int n, const Model& lagrangian) {
+  return constant_mass_form_of([&] {
+    Vec<VelocityStructure> q(m), v(n);
+    for (int i = 0; i < m; ++i) q(i) = VelocityStructure::position(0.5);
+    for (int i = 0; i < n; ++i) v(i) = VelocityStructure::velocity(0.5);
+    return lagrangian(q, v);
+  });
 }
 
 }  // namespace varia::sdk
