@@ -6,6 +6,7 @@
 
 #include <Eigen/Core>
 #include <chrono>
+#include <malloc.h>
 
 #include "morse_chain.hpp"
 
@@ -315,6 +316,34 @@ TEST_CASE("hessian_jet above the stack size (a dense model of 10 + 10 numbers wi
     CHECK(hessian[i].constant());
     CHECK(hessian[i].value == doctest::Approx(expected[i]).epsilon(1e-15));
   }
+}
+
+namespace {
+// The bytes this process holds from malloc (glibc: small blocks and mmapped ones).
+std::size_t heap_bytes() {
+  const struct mallinfo2 info = mallinfo2();
+  return info.uordblks + info.hblkhd;
+}
+}  // namespace
+
+TEST_CASE("a dense model of sizes read at run time allocates at construction only its value's inputs, each "
+          "workspace comes at its first use, the (m + n)^2 Hessian at constants only when asked for (it was "
+          "allocated at construction: 134 MB for 2048 + 2048 numbers)") {
+  const int n = 2048, k = 2 * n;
+  const std::size_t before = heap_bytes();
+  VaryingMassChain large(n);
+  CHECK(heap_bytes() - before < 64 * static_cast<std::size_t>(k));
+
+  // Where it must not hold: the Hessian at constant jets needs its (m + n)^2 workspace, and the count sees it.
+  VaryingMassChain small(100);
+  const std::vector<varia::Jet2> constants(200, varia::Jet2(0.4));
+  std::vector<varia::Jet2> hessian(200 * 200);
+  const std::size_t asked = heap_bytes();
+  REQUIRE(small.hessian_jet(constants.data(), constants.data() + 100, hessian.data()) == nullptr);
+  CHECK(heap_bytes() - asked >= 200 * 200 * sizeof(double));
+  const std::size_t again = heap_bytes();
+  REQUIRE(small.hessian_jet(constants.data(), constants.data() + 100, hessian.data()) == nullptr);
+  CHECK(heap_bytes() == again);  // sized once
 }
 
 TEST_CASE("above the stack size a dense autodiff Lagrangian evaluates at jets (over its workspace's dual numbers): "

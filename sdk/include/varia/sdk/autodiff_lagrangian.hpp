@@ -67,15 +67,6 @@ class AutodiffLagrangian : public Lagrangian {
       : m_(position_size), n_(velocity_size), q_(position_size), v_(velocity_size) {
     if ((Positions != Eigen::Dynamic && m_ != Positions) || (Velocities != Eigen::Dynamic && n_ != Velocities))
       throw std::logic_error("an AutodiffLagrangian<Model, Positions, Velocities> is constructed with m = Positions and n = Velocities");
-    if (m_ + n_ > kStackVariables) {
-      chunk_q_.resize(m_), chunk_v_.resize(n_);
-      chunk2_q_.resize(m_), chunk2_v_.resize(n_);
-    }
-    if (!kFixed) {
-      jet_q_.resize(m_), jet_v_.resize(n_);
-      hessian_jet_q_.resize(m_), hessian_jet_v_.resize(n_), hessian_jet_z_.resize(m_ + n_);
-    }
-    at_constants_.resize(m_ + n_), hessian_at_constants_.resize((m_ + n_) * (m_ + n_));
   }
   int position_size() const noexcept final { return m_; }
   int velocity_size() const noexcept final { return n_; }
@@ -171,6 +162,7 @@ class AutodiffLagrangian : public Lagrangian {
           if (jet_variables(q, v) == kFixedJetVariables) return at_fixed_jets<kFixedJetVariables>(q, v, value, gradient);
         at_stack_jets(q, v, value, gradient);
       } else {
+        jet_q_.resize(m_), jet_v_.resize(n_);
         at_jets(jet_q_, jet_v_, q, v, value, gradient);
       }
     });
@@ -188,6 +180,7 @@ class AutodiffLagrangian : public Lagrangian {
           if (variables <= kFixedJetVariables) return hessian_at_stack_jets<kFixedJetVariables>(q, v, variables, hessian);
         hessian_at_stack_jets<kMaxHessianJetVariables>(q, v, variables, hessian);
       } else {
+        hessian_jet_q_.resize(m_), hessian_jet_v_.resize(n_), hessian_jet_z_.resize(m_ + n_);
         hessian_at_jets(hessian_jet_q_, hessian_jet_v_, hessian_jet_z_.data(), q, v, variables, hessian);
       }
     });
@@ -432,11 +425,12 @@ class AutodiffLagrangian : public Lagrangian {
   // Constant inputs: the Hessian at their values (evaluate's, at any size), as constant jets.
   void hessian_at_constants(const Jet2* q, const Jet2* v, Jet2* hessian) {
     const int k = m_ + n_;
+    at_constants_.resize(k), hessian_at_constants_.resize(static_cast<std::size_t>(k) * k);
     for (int i = 0; i < k; ++i) at_constants_[i] = at(q, v, m_, i).value;
     if (const Status status = evaluate(at_constants_.data(), at_constants_.data() + m_, nullptr, nullptr,
                                        hessian_at_constants_.data()))
       throw std::runtime_error(status);
-    for (int i = 0; i < k * k; ++i) hessian[i] = Jet2(hessian_at_constants_[i]);
+    for (std::size_t i = 0; i < hessian_at_constants_.size(); ++i) hessian[i] = Jet2(hessian_at_constants_[i]);
   }
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).
@@ -458,6 +452,7 @@ class AutodiffLagrangian : public Lagrangian {
   // (q, v) per pass of the model.
   void chunked_first_order(const double* q, const double* v, double* value, double* gradient) {
     const int k = m_ + n_;
+    chunk_q_.resize(m_), chunk_v_.resize(n_);
     for (int first = 0; first < k; first += kChunkDirections) {
       const int size = std::min(kChunkDirections, k - first);
       for (int i = 0; i < k; ++i) seed(input(chunk_q_, chunk_v_, i), at(q, v, m_, i), size, i - first);
@@ -471,6 +466,7 @@ class AutodiffLagrangian : public Lagrangian {
   void chunked_second_order(const double* q, const double* v, double* value, double* gradient,
                             double* hessian) {
     const int k = m_ + n_;
+    chunk2_q_.resize(m_), chunk2_v_.resize(n_);
     for (int a = 0; a < k; a += kChunkDirections) {
       const int inner = std::min(kChunkDirections, k - a);
       for (int b = a; b < k; b += kChunkDirections) {
@@ -489,8 +485,10 @@ class AutodiffLagrangian : public Lagrangian {
 
   int m_, n_;
   mutable std::optional<bool> constant_mass_form_;
-  // Workspace, sized once: the value's inputs, above kStackVariables the chunks' dual inputs, and
-  // for sizes read at run time the dual inputs over jets.
+  // Workspace: the value's inputs, sized at construction; above kStackVariables the chunks' dual
+  // inputs, and for sizes read at run time the dual inputs over jets, each sized at its first use (a
+  // resize to the size it has is free), so a model allocates only what the constructions ask of it:
+  // the Hessian at constants alone is (m + n)^2 numbers.
   Vec<double> q_, v_;
   Vec<ChunkJetDual> jet_q_, jet_v_;
   Vec<ChunkDual> chunk_q_, chunk_v_;
