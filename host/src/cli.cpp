@@ -122,7 +122,7 @@ void add_scene(CLI::App* sub, std::string& scene) {
 
 using Command = std::function<int()>;
 
-void define_commands(CLI::App& app, Options& o, Command& chosen) {
+void define_plugins(CLI::App& app, Options& o, Command& chosen) {
   auto* plugins = subcommand(app, o, "plugins",
                              "List every plugin found: kind, type name, version, file, declared properties and "
                              "parameters; files refused are listed after them with the reason.",
@@ -130,7 +130,9 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
   plugins->add_flag("--json", o.json, "print a JSON array of objects {kind, type, version, file, properties, "
                                       "parameter_schema}; refusals go to stderr");
   plugins->callback([&] { chosen = [&] { return command_plugins(o.common, o.json); }; });
+}
 
+void define_run(CLI::App& app, Options& o, Command& chosen) {
   auto* run = subcommand(app, o, "run",
                          "Simulate a scene. Without --out no trajectory is written (--out - writes the CSV to "
                          "stdout, and the human summary then goes to stderr). A short human summary is "
@@ -155,7 +157,9 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
     if (!o.run_plot.empty()) o.run.plot = o.run_plot;
     chosen = [&] { return command_run(o.common, o.scene, o.run); };
   });
+}
 
+void define_ld(CLI::App& app, Options& o, Command& chosen) {
   auto* ld = subcommand(app, o, "ld",
                         "Evaluate the scene's discrete Lagrangian L_d(q0, q1; h) and its derivatives D1 L_d, "
                         "D2 L_d at one point.",
@@ -166,14 +170,18 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
   ld->add_option("--h", o.ld.h, "the step size")->required()->type_name("H");
   ld->add_flag("--json", o.ld.json, "print {\"Ld\": x, \"D1\": [...], \"D2\": [...]}");
   ld->callback([&] { chosen = [&] { return command_ld(o.common, o.scene, o.ld); }; });
+}
 
+void define_validate(CLI::App& app, Options& o, Command& chosen) {
   auto* validate = subcommand(app, o, "validate",
                               "Check a scene against the scene schema and the plugins' parameter schemas, "
                               "and build its integrator, without running it.",
                               "Example:\n  varia validate scenes/default.json");
   add_scene(validate, o.scene);
   validate->callback([&] { chosen = [&] { return command_validate(o.common, o.scene); }; });
+}
 
+void define_verify(CLI::App& app, Options& o, Command& chosen) {
   auto* verify = subcommand(app, o, "verify",
                             "Check the theorem properties of the scene's discrete Lagrangian and integrator: predict "
                             "each from the declared properties of the parts (the paper's theorems), measure it, "
@@ -196,7 +204,9 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
   verify->callback([&] {
     chosen = [&] { return command_verify(o.common, o.scene, o.verify_json, o.verify_h, o.verify_explain); };
   });
+}
 
+void define_cost(CLI::App& app, Options& o, Command& chosen) {
   auto* cost = subcommand(app, o, "cost",
                           "What accuracy costs in time: error, work and time across step sizes and methods, "
                           "as CSV and a plot.",
@@ -214,6 +224,15 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
     if (!o.cost_out.empty()) o.cost.out = o.cost_out;
     chosen = [&] { return command_cost(o.common, o.scenes, o.cost); };
   });
+}
+
+void define_commands(CLI::App& app, Options& o, Command& chosen) {
+  define_plugins(app, o, chosen);
+  define_run(app, o, chosen);
+  define_ld(app, o, chosen);
+  define_validate(app, o, chosen);
+  define_verify(app, o, chosen);
+  define_cost(app, o, chosen);
 }
 
 // CLI11 reports a mistyped command as "A subcommand is required"; name it instead.
