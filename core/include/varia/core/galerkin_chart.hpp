@@ -75,9 +75,14 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   // groups listed in choose_kernels() (SO(3), SE(3)) and Eigen::Dynamic for any other: one piece
   // of code, instantiated once per size and chosen once, at construction.
   void choose_kernels();
-  // Adds quadrature node i: L at the chart curve and the chain rule through the chart's jets.
+  // Adds quadrature node i: L at the chart curve and the chain rule through the chart's jets
+  // (chain_to_node), weighted into the action's derivatives (add_to_action).
   template <int N, int M>
   double add_node(const double* q0, int i, double h, bool with_hessian, bool with_value);
+  template <int N, int M>
+  void chain_to_node(bool with_hessian);
+  template <int N>
+  void add_to_action(int i, double h, bool with_hessian);
   // dexp_{sign w} (= d velocity / d xi_dot at xi = -sign w) into dexp_, its inverse transpose,
   // and (with_derivatives) its derivatives in (sign w)_l (one n x n matrix each), from the
   // manifold's chart at jets.
@@ -106,6 +111,7 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   bool warm_start(const double* q0, const double* p0, double h);
   auto previous() { return history_.rightCols(s_ + 1); }  // the last step's control points
   void check(Status status) const;
+  void size_workspace();  // once, at construction
 
   Manifold& manifold_;
   LagrangianEvaluator lagrangian_;
