@@ -214,6 +214,14 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
     control_map_.col(0) = line;
     for (int j = 0; j < R; ++j) node_map_(j, 0) = nodes_[iteration_nodes_[j]];
   }
+  prepare_node_iteration();
+  return true;
+}
+
+// The node iteration's workspace (galerkin_node_iteration.cpp) and its warm start's extrapolations of the
+// nodes' accelerations from the last steps, once the maps are formed.
+void GalerkinDiscreteLagrangian::prepare_node_iteration() {
+  const int R = static_cast<int>(iteration_nodes_.size());
   mass_norm_ = mass_matrix_.cwiseAbs().rowwise().sum().maxCoeff();
   end_map_ = control_map_.bottomRows(1);
   velocity0_.resize(n_);
@@ -238,7 +246,6 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
     prediction_map_[k].col(0) = node_map_.col(0);
     prediction_map_[k].rightCols(2 * R).noalias() = node_map_.rightCols(R) * acceleration_extrapolation_[k].transpose();
   }
-  return true;
 }
 
 void GalerkinDiscreteLagrangian::take_steps(double* q, double* p, double t0, double h, long steps, double* q1,

@@ -66,7 +66,21 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
       m_(manifold.point_size()),
       n_(manifold.dim()) {
   method_.set_solver(options.tolerance, options.max_iterations);
-  // The nodes 0 = c_0 < ... < c_n = 1 with zero weights where the rule has no node (paper, sec. 3).
+  take_quadrature(quadrature);
+  refuse_unsupported();
+  if (jet_capacity < 2 || jet_capacity > kMaxJetVariables)
+    throw std::invalid_argument("the shooting construction's jets hold 2 to " + std::to_string(kMaxJetVariables) +
+                                " variables");
+  plan_passes(std::min(jet_capacity, field_->jet_variables()));
+  size_workspace();
+  if (mechanical_ != nullptr) mechanical_->set_origin(origin_.data());
+  offer_explicit_shot(lagrangian);
+  step_ = step_function(n_, manifold_.is_vector_space());
+}
+
+// The nodes 0 = c_0 < ... < c_n = 1 with zero weights where the rule has no node (paper, sec. 3),
+// and the rule's end corrections (first derivatives of the integrand at 0 and 1 only).
+void ShootingDiscreteLagrangian::take_quadrature(Quadrature& quadrature) {
   const double* c = quadrature.nodes();
   const double* b = quadrature.weights();
   const int size = quadrature.size();
@@ -93,6 +107,11 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
                                   "first derivative of the integrand only");
     }
   }
+}
+
+// What the construction does not take: forces in the type-2 form, and end corrections anywhere but
+// on a vector space without forces for a Lagrangian with a constant mass matrix.
+void ShootingDiscreteLagrangian::refuse_unsupported() const {
   if (!forces_.empty() && type_2())
     throw std::invalid_argument("the shooting construction takes forces in the lagrangian and "
                                 "hamiltonian forms (Type I generating functions), not type-2");
@@ -100,6 +119,9 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
       (start_correction_ != 0.0 || end_correction_ != 0.0))
     throw std::invalid_argument("the shooting construction takes end-derivative quadratures on vector spaces "
                                 "without forces, for a Lagrangian with a constant mass matrix, only");
+}
+
+void ShootingDiscreteLagrangian::size_workspace() {
   state_.resize(field_->size());
   next_.resize(field_->size());
   target_.resize(m_);
@@ -107,10 +129,6 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   alpha_.resize(2 * n_);
   zero_.assign(std::max(m_, n_), 0.0);
   slot_.resize(2 * n_);
-  if (jet_capacity < 2 || jet_capacity > kMaxJetVariables)
-    throw std::invalid_argument("the shooting construction's jets hold 2 to " + std::to_string(kMaxJetVariables) +
-                                " variables");
-  plan_passes(std::min(jet_capacity, field_->jet_variables()));
   acceleration_.resize(n_);
   gradient_.resize(m_ + n_);
   boundary_.resize(n_);
@@ -136,13 +154,17 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   guess_.resize(n_);
   corrections_history_.resize(n_, kCorrections);
   origin_.resize(n_);
-  if (mechanical_ != nullptr) mechanical_->set_origin(origin_.data());
   Bq_.resize(n_, n_);
   Bw_.resize(n_, n_);
   phi_.resize(2 * n_, 2 * n_);
   jacobian_.resize(n_, n_);
   BwT_solver_ = SmallDenseSolver(n_);
   jacobian_solver_ = SmallDenseSolver(n_);
+}
+
+// Where the step is one recurrence (an explicit method, a constant mass matrix, no forces or end
+// corrections, one pass), the plugin is offered to run the shot with its model inlined.
+void ShootingDiscreteLagrangian::offer_explicit_shot(Lagrangian& lagrangian) {
   const RungeKuttaTableau tableau = method_.explicit_tableau();
   if (offsets() && form_ == ShootingForm::lagrangian && field_->constant_mass() && forces_.empty() &&
       start_correction_ == 0.0 && end_correction_ == 0.0 && tableau.stages > 0 && passes_.size() == 1) {
@@ -152,7 +174,6 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
     shot.plan = &shot_plan_;
     plugin_shoots_ = lagrangian.offers(kernel::call(shot));
   }
-  step_ = step_function(n_, manifold_.is_vector_space());
 }
 
 // The passes of a propagation. When the jets hold all 2n numbers of x = (eta, w0), one pass gives

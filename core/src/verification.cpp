@@ -26,14 +26,93 @@ double log_log_slope(const std::vector<double>& h, const std::vector<double>& va
   return sxy / sxx;
 }
 
-constexpr double kWindow = 2.0 * (1.0 - 1e-9);
-constexpr double kSpan = 1e6;  // an order ladder wants its largest error this far above its floor  // a factor 2 in h, whatever the rounding of h
+constexpr double kWindow = 2.0 * (1.0 - 1e-9);  // a factor 2 in h, whatever the rounding of h
+constexpr double kSpan = 1e6;  // an order ladder wants its largest error this far above its floor
 
 std::vector<int> above(const std::vector<double>& value, double floor) {
   std::vector<int> kept;
   for (std::size_t k = 0; k < value.size(); ++k)
     if (value[k] > floor) kept.push_back(static_cast<int>(k));
   return kept;
+}
+
+// The errors of an order ladder (h decreasing) and their local slopes, each over a window of a
+// factor 2 in h (on a fine ladder neighbouring slopes differ too little to show a trend).
+struct Ladder {
+  const std::vector<double>& h;
+  const std::vector<double>& error;
+
+  double slope_between(int a, int b) const { return std::log(error[a] / error[b]) / std::log(h[a] / h[b]); }
+  // The window from points[a] forwards, or from points[c] backwards.
+  std::size_t window_end(const std::vector<int>& points, std::size_t a) const {
+    std::size_t b = a + 1;
+    while (b + 1 < points.size() && h[points[a]] / h[points[b]] < kWindow) ++b;
+    return b;
+  }
+  std::size_t window_start(const std::vector<int>& points, std::size_t c) const {
+    std::size_t a = c - 1;
+    while (a > 0 && h[points[a]] / h[points[c]] < kWindow) --a;
+    return a;
+  }
+  std::vector<double> local_slopes(const std::vector<int>& points) const {
+    std::vector<double> local;
+    for (std::size_t a = 0; a + 1 < points.size(); ++a) {
+      const std::size_t b = window_end(points, a);
+      if (h[points[a]] / h[points[b]] >= kWindow) local.push_back(slope_between(points[a], points[b]));
+    }
+    return local;
+  }
+};
+
+// Leading points whose local slope differs from the next one's by more than 0.3: pre-asymptotic.
+void drop_pre_asymptotic(const Ladder& l, std::vector<int>& kept, OrderFit& fit) {
+  while (kept.size() >= 3) {
+    const std::size_t b = l.window_end(kept, 0);
+    if (b + 1 >= kept.size()) break;
+    const std::size_t c = l.window_end(kept, b);
+    const double first = l.slope_between(kept[0], kept[b]), next = l.slope_between(kept[b], kept[c]);
+    if (std::abs(first - next) <= 0.3) break;
+    std::ostringstream why;
+    why << "h = " << l.h[kept[0]] << ": pre-asymptotic (local slope " << first << ", next " << next << ")";
+    fit.dropped.push_back(why.str());
+    kept.erase(kept.begin());
+  }
+}
+
+// Trailing points whose local slope falls below the one before: a round-off plateau (the errors
+// stop falling).
+void drop_round_off_plateau(const Ladder& l, std::vector<int>& kept, OrderFit& fit) {
+  while (kept.size() >= 3) {
+    const std::size_t last = kept.size() - 1, b = l.window_start(kept, last);
+    if (b == 0) break;
+    const std::size_t a = l.window_start(kept, b);
+    const double tail = l.slope_between(kept[b], kept[last]), before = l.slope_between(kept[a], kept[b]);
+    if (tail >= before - 0.3) break;
+    std::ostringstream why;
+    why << "h = " << l.h[kept.back()] << ": at round-off (local slope " << tail << ", before it " << before << ")";
+    fit.dropped.push_back(why.str());
+    kept.pop_back();
+  }
+}
+
+// The order is the limit of the local slope as h -> 0. While a term of the next order still shows,
+// the local slopes creep towards it geometrically (s(h) = p + c h^k on a geometric ladder); when
+// the last four do so consistently (their differences keep one sign and shrink by a steady ratio
+// below 0.9), Aitken's delta-squared takes the limit, and the note says so.
+void extrapolate_creeping_slopes(const std::vector<double>& local, OrderFit& fit) {
+  if (local.size() < 4) return;
+  const std::size_t n = local.size();
+  const double d1 = local[n - 3] - local[n - 4], d2 = local[n - 2] - local[n - 3], d3 = local[n - 1] - local[n - 2];
+  const double r1 = d2 / d1, r2 = d3 / d2;
+  if (!(r1 > 0 && r1 <= 0.9 && r2 > 0 && r2 <= 0.9 && std::abs(r2 - r1) <= 0.2)) return;
+  const double limit = local[n - 1] + d3 * r2 / (1 - r2);
+  std::ostringstream why;
+  why << "local slopes " << local[n - 4] << ", " << local[n - 3] << ", " << local[n - 2] << ", " << local[n - 1]
+      << " still creeping (differences shrinking by " << r1 << ", " << r2 << "): order " << limit
+      << " by Aitken extrapolation, least-squares slope " << fit.slope;
+  fit.extrapolated = why.str();
+  fit.slope = limit;
+  fit.still_rising = false;
 }
 
 }  // namespace
@@ -49,81 +128,22 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& erro
     why << "h = " << h[k] << ": error " << error[k] << " at round-off (below " << floor << ")";
     fit.dropped.push_back(why.str());
   }
-  // The local slope over a window of a factor 2 in h, from kept[a] forwards or from kept[c]
-  // backwards (on a fine ladder neighbouring slopes differ too little to show a trend).
-  auto slope_between = [&](int a, int b) { return std::log(error[a] / error[b]) / std::log(h[a] / h[b]); };
-  auto window_end_in = [&](const std::vector<int>& points, std::size_t a) {
-    std::size_t b = a + 1;
-    while (b + 1 < points.size() && h[points[a]] / h[points[b]] < kWindow) ++b;
-    return b;
-  };
-  auto window_end = [&](std::size_t a) { return window_end_in(kept, a); };
-  auto window_start = [&](std::size_t c) {
-    std::size_t a = c - 1;
-    while (a > 0 && h[kept[a]] / h[kept[c]] < kWindow) --a;
-    return a;
-  };
-  // The local slopes of a list of points (indices, h decreasing), each over a window of a factor 2.
-  auto local_slopes = [&](const std::vector<int>& points) {
-    std::vector<double> local;
-    for (std::size_t a = 0; a + 1 < points.size(); ++a) {
-      const std::size_t b = window_end_in(points, a);
-      if (h[points[a]] / h[points[b]] >= kWindow) local.push_back(slope_between(points[a], points[b]));
-    }
-    return local;
-  };
-  while (kept.size() >= 3) {
-    const std::size_t b = window_end(0);
-    if (b + 1 >= kept.size()) break;
-    const std::size_t c = window_end(b);
-    const double first = slope_between(kept[0], kept[b]), next = slope_between(kept[b], kept[c]);
-    if (std::abs(first - next) <= 0.3) break;
-    std::ostringstream why;
-    why << "h = " << h[kept[0]] << ": pre-asymptotic (local slope " << first << ", next " << next << ")";
-    fit.dropped.push_back(why.str());
-    kept.erase(kept.begin());
-  }
-  // Trailing points whose local slope falls below the one before: a round-off plateau (the
-  // errors stop falling).
-  while (kept.size() >= 3) {
-    const std::size_t last = kept.size() - 1, b = window_start(last);
-    if (b == 0) break;
-    const std::size_t a = window_start(b);
-    const double tail = slope_between(kept[b], kept[last]), before = slope_between(kept[a], kept[b]);
-    if (tail >= before - 0.3) break;
-    std::ostringstream why;
-    why << "h = " << h[kept.back()] << ": at round-off (local slope " << tail << ", before it " << before << ")";
-    fit.dropped.push_back(why.str());
-    kept.pop_back();
-  }
+  const Ladder ladder{h, error};
+  drop_pre_asymptotic(ladder, kept, fit);
+  drop_round_off_plateau(ladder, kept, fit);
   fit.used = static_cast<int>(kept.size());
   if (!fit.fitted()) return fit;
   fit.h_span = h[kept.front()] / h[kept.back()];
   fit.slope = log_log_slope(h, error, kept);
-  // The order is the limit of the local slope as h -> 0. While a term of the next order still
-  // shows, the local slopes creep towards it geometrically (s(h) = p + c h^k on a geometric
-  // ladder); when the last four do so consistently (their differences keep one sign and shrink by a
-  // steady ratio below 0.9), Aitken's delta-squared takes the limit, and the note says so.
-  const std::vector<double> local = local_slopes(kept);
+  const std::vector<double> local = ladder.local_slopes(kept);
   if (!local.empty()) fit.slope_spread = *std::max_element(local.begin(), local.end()) - *std::min_element(local.begin(), local.end());
+  // Still rising: the local slopes of every point above round-off down to the fit's end rise at its end.
   std::vector<int> trend = above(error, floor);
   trend.erase(std::find(trend.begin(), trend.end(), kept.back()) + 1, trend.end());
-  const std::vector<double> trend_local = local_slopes(trend);
+  const std::vector<double> trend_local = ladder.local_slopes(trend);
   const std::size_t m = trend_local.size();
   fit.still_rising = m >= 2 && trend_local[m - 1] > trend_local[m - 2] && (m == 2 || trend_local[m - 2] > trend_local[m - 3]);
-  if (local.size() < 4) return fit;
-  const std::size_t n = local.size();
-  const double d1 = local[n - 3] - local[n - 4], d2 = local[n - 2] - local[n - 3], d3 = local[n - 1] - local[n - 2];
-  const double r1 = d2 / d1, r2 = d3 / d2;
-  if (!(r1 > 0 && r1 <= 0.9 && r2 > 0 && r2 <= 0.9 && std::abs(r2 - r1) <= 0.2)) return fit;
-  const double limit = local[n - 1] + d3 * r2 / (1 - r2);
-  std::ostringstream why;
-  why << "local slopes " << local[n - 4] << ", " << local[n - 3] << ", " << local[n - 2] << ", " << local[n - 1]
-      << " still creeping (differences shrinking by " << r1 << ", " << r2 << "): order " << limit
-      << " by Aitken extrapolation, least-squares slope " << fit.slope;
-  fit.extrapolated = why.str();
-  fit.slope = limit;
-  fit.still_rising = false;
+  extrapolate_creeping_slopes(local, fit);
   return fit;
 }
 

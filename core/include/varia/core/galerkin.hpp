@@ -139,6 +139,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // nodes of nonzero weight <= 7 where both are small (loops of a fixed length), Eigen::Dynamic
   // otherwise, chosen once (step_).
   bool simplified_applies();
+  void prepare_node_iteration();  // simplified_applies's last part
   Eigen::MatrixXd extrapolation_to_nodes(const std::vector<double>& times) const;
   template <int N, int R>
   struct NodeIteration;

@@ -139,6 +139,11 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
     std::vector<int> variables;
     bool first_order, second_order;
   };
+  // Parts of the constructor (with plan_passes).
+  void take_quadrature(Quadrature& quadrature);
+  void refuse_unsupported() const;
+  void size_workspace();
+  void offer_explicit_shot(Lagrangian& lagrangian);
   void plan_passes(int capacity);
   // The jet of x's number `variable` (-1: none) at `value` in the current pass: one of its
   // variables, or a jet of zero derivatives in them. Every pass's jets have jet_size_ variables,
