@@ -8,22 +8,19 @@
 //
 // The model is compiled once per scalar type that its sizes need, and no more: with sizes given
 // at compile time (M + N <= kMaxFixedVariables) the dual numbers have that fixed size, so the
-// arithmetic is unrolled and a second-order scalar holds (k+1)^2 doubles; with sizes read at run
-// time one family of capacity-bounded dual numbers serves every size up to kStackVariables (18),
-// on the stack, so an evaluation allocates nothing. Above it the
-// Hessian is dense all the same, and forward mode runs in chunks of kChunkDirections directions
-// over workspace vectors sized once: k/8 passes of the model for the gradient, one pass per pair
-// of chunks for the Hessian, so a Hessian costs about k^2/64 evaluations of the model at 81-double
-// scalars. A large system whose L is a sum of terms over few numbers each is better written as a
-// TermwiseLagrangian (termwise_lagrangian.hpp): linear cost and a sparse Hessian. The same model,
-// evaluated at dual numbers over second-order jets (kJetDirections derivative directions at a
-// time), gives gradient_jet at any size (sizes read at run time: over inputs kept in a workspace
-// sized once). Forward mode over forward mode at jet values (jet_tangent.hpp)
-// gives hessian_jet at jets of up to 6 variables and any size, which the shooting construction's
-// lagrangian form needs for a configuration-dependent mass matrix (it propagates in passes of at
-// most that many variables). The same first-order pass, inlined into
-// one loop, gives the gradients at several points in one call (gradients) and runs the Galerkin
-// explicit form's Stormer-Verlet steps inside the plugin (kernel::StormerVerletSteps).
+// arithmetic is unrolled; with sizes read at run time one family of capacity-bounded dual numbers
+// serves every size up to kStackVariables (18), on the stack, so an evaluation allocates nothing.
+// Above it forward mode runs in chunks of kChunkDirections directions over workspace vectors sized
+// at their first use: k/8 passes of the model for the gradient, one pass per pair of chunks for
+// the dense Hessian (about k^2/64 evaluations at 81-double scalars). A large system whose L is a
+// sum of terms over few numbers each is better written as a TermwiseLagrangian
+// (termwise_lagrangian.hpp): linear cost and a sparse Hessian. The same model at dual numbers over
+// second-order jets (kJetDirections directions at a time) gives gradient_jet at any size; forward
+// over forward mode at jet values (jet_tangent.hpp) gives hessian_jet at jets of up to 6 variables
+// and any size, which shooting's lagrangian form needs for a configuration-dependent mass matrix.
+// The first-order pass, inlined into one loop, gives the gradients at several points in one call
+// (gradients) and runs the Galerkin explicit form's Stormer-Verlet steps inside the plugin
+// (kernel::StormerVerletSteps).
 #pragma once
 
 #include <Eigen/Core>
@@ -133,23 +130,25 @@ class AutodiffLagrangian : public Lagrangian {
 
   // L = 1/2 v^T M v - V(q) with a constant M, read off the model's expression
   // (velocity_structure.hpp), so that no model need declare it: M is then L's Hessian's vv block,
-  // the same at every point (here (q, v) = (1/2, ..., 0)). A model may still override this (as
-  // its own declaration, or to refuse the explicit forms); the conformance suite checks a declared
-  // M against the Hessian.
+  // the same at every point (here (q, v) = (1/2, ..., 0)); above kStackVariables only that block is
+  // formed (n^2 numbers, not (m + n)^2). A model may still override this (as its own declaration,
+  // or to refuse the explicit forms); the conformance suite checks a declared M against the Hessian.
   bool constant_mass_matrix(double* mass) const noexcept override {
     if (!has_constant_mass_form()) return false;
+    auto* self = const_cast<AutodiffLagrangian*>(this);  // keeps no state between calls but its workspace
     const int k = m_ + n_;
-    std::vector<double> q(m_, 0.5), v(n_, 0.0), hessian(k * k);
-    // evaluate() keeps no state between calls but the workspace it overwrites.
-    if (const_cast<AutodiffLagrangian*>(this)->evaluate(q.data(), v.data(), nullptr, nullptr, hessian.data()) != nullptr)
-      return false;
-    for (int j = 0; j < n_; ++j)
-      for (int i = 0; i < n_; ++i) {
-        const double entry = hessian[(m_ + j) * k + m_ + i];
-        if (!std::isfinite(entry)) return false;
-        mass[j * n_ + i] = entry;
-      }
-    return true;
+    std::vector<double> q(m_, 0.5), v(n_, 0.0);
+    if (above_stack()) {
+      if constexpr (!kFixed)
+        if (guarded(self->error_, [&] { self->chunked_second_order(q.data(), v.data(), nullptr, nullptr, mass, m_); }))
+          return false;
+    } else {
+      std::vector<double> hessian(k * k);
+      if (self->evaluate(q.data(), v.data(), nullptr, nullptr, hessian.data()) != nullptr) return false;
+      for (int j = 0; j < n_; ++j)
+        for (int i = 0; i < n_; ++i) mass[j * n_ + i] = hessian[(m_ + j) * k + m_ + i];
+    }
+    return std::all_of(mass, mass + n_ * n_, [](double entry) { return std::isfinite(entry); });
   }
 
   // At jets the model runs at dual numbers over jets, kJetDirections numbers of (q, v) at a time:
@@ -462,12 +461,13 @@ class AutodiffLagrangian : public Lagrangian {
     }
   }
   // And the Hessian: forward over forward, one pass per pair of chunks (a, b) with b >= a, whose
-  // block of second derivatives gives H(a.., b..) and, by symmetry, H(b.., a..).
-  void chunked_second_order(const double* q, const double* v, double* value, double* gradient,
-                            double* hessian) {
-    const int k = m_ + n_;
+  // block of second derivatives gives H(a.., b..) and, by symmetry, H(b.., a..). With first > 0,
+  // only the block of the numbers first.. of (q, v) (value and gradient null).
+  void chunked_second_order(const double* q, const double* v, double* value, double* gradient, double* hessian,
+                            int first = 0) {
+    const int k = m_ + n_, size = k - first;
     chunk2_q_.resize(m_), chunk2_v_.resize(n_);
-    for (int a = 0; a < k; a += kChunkDirections) {
+    for (int a = first; a < k; a += kChunkDirections) {
       const int inner = std::min(kChunkDirections, k - a);
       for (int b = a; b < k; b += kChunkDirections) {
         const int outer = std::min(kChunkDirections, k - b);
@@ -478,17 +478,16 @@ class AutodiffLagrangian : public Lagrangian {
           for (int i = 0; i < inner; ++i) gradient[a + i] = derivative(r.value(), i);
         for (int j = 0; j < outer; ++j)
           for (int i = 0; i < inner; ++i)
-            hessian[(a + i) * k + b + j] = hessian[(b + j) * k + a + i] = second_derivative(r, j, i);
+            hessian[(a - first + i) * size + b - first + j] = hessian[(b - first + j) * size + a - first + i] =
+                second_derivative(r, j, i);
       }
     }
   }
 
   int m_, n_;
   mutable std::optional<bool> constant_mass_form_;
-  // Workspace: the value's inputs, sized at construction; above kStackVariables the chunks' dual
-  // inputs, and for sizes read at run time the dual inputs over jets, each sized at its first use (a
-  // resize to the size it has is free), so a model allocates only what the constructions ask of it:
-  // the Hessian at constants alone is (m + n)^2 numbers.
+  // Workspace: the value's inputs; the others (the chunks' and the jets' dual inputs, the Hessian at
+  // constants) are sized at their first use, so a model allocates only what the constructions ask of it.
   Vec<double> q_, v_;
   Vec<ChunkJetDual> jet_q_, jet_v_;
   Vec<ChunkDual> chunk_q_, chunk_v_;
