@@ -177,8 +177,8 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
   if (mass.info() != Eigen::Success) return false;
   inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
   // In long double (64-bit mantissa on x86, else double): K's block is ill-conditioned at larger s,
-  // and a map's rounding is a change of the method, the same at every step (formed in double, the
-  // s = 6 Gauss steps of the pendulum ended 5.0e-14 from gni_irk2's over 2000 steps, against 2.7e-15).
+  // and a map's rounding is a change of the method, the same at every step (bench/README.md,
+  // "Measured design choices").
   using Extended = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
   const int r = static_cast<int>(nodes_.size());
   Extended phi(s_ + 1, r), dphi(s_ + 1, r), stiffness = Extended::Zero(s_ + 1, s_ + 1);
@@ -204,9 +204,7 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
   // integrates l'_nu exactly (sum_mu K_numu d_mu = l_nu(1) - l_nu(0)): then alpha_mu = d_mu, and
   // the nodes' coefficient of u0 is c_j. Where alpha agrees with that to rounding, the exact values
   // are taken: through K^{-1} alpha_s is off by an ulp, the same at every step, and q1 - q0 =
-  // h alpha_s u0 + ... walked by an ulp of h u0 a step (with the maps in double, the s = 4 Gauss
-  // steps of the pendulum ended 3.5e-14 from gni_irk2's over 4000 steps without this, 3.7e-15 with
-  // it; in long double without it, the s = 6 steps parted from exact Newton's by 4e-14, 1e-14 with).
+  // h alpha_s u0 + ... walked by an ulp of h u0 a step (bench/README.md, "Measured design choices").
   const Eigen::VectorXd line = Eigen::Map<const Eigen::VectorXd>(basis_.control_times.data() + 1, s_);
   control_map_ = control.cast<double>();
   node_map_ = (interpolation * control).cast<double>();

@@ -73,8 +73,7 @@ template <int N, int Rows, int C>
 // (1/h) M sum_mu K_numu (X^mu - X'^mu)): the stopping rule's tolerance means what it means for
 // the equations, and its yardstick is theirs, |p0| and the kinetic terms |M D'| / h. (The
 // offsets' difference itself is smaller by h / |M|: at tolerance (1 + yardstick) in positions the
-// rule stopped with systematic errors h^-1 times larger, and the s = 6 Gauss steps of the
-// pendulum ended 1.6e-13 from gni_irk2's instead of 2e-15.)
+// rule stopped with systematic errors h^-1 times larger; bench/README.md, "Measured design choices".)
 template <int N, int R>
 [[gnu::always_inline]] inline double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, double momentum,
                                                                                double* __restrict F) {

@@ -340,7 +340,7 @@ void exact_discrete_lagrangian(LagrangianEvaluator& lagrangian, const double* no
 }
 
 void run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::VectorXd& p, double t0, double h,
-         long steps, const Observer& observe) {
+         long steps, const StateVisitor& observe) {
   Trajectory trajectory(map, q, p, t0, h);
   observe(0, q.data(), p.data());
   trajectory.run_to(steps, [&](const Trajectory& x) {

@@ -40,12 +40,12 @@ void stop_before(const char* property, double h) {
   if (interruption() != 0) stop_if_interrupted(fmt::format("before verify's {} at h = {:.4g}", property, h));
 }
 
-std::vector<double> velocity_of(Context& x, const double* q, const double* p, std::vector<double> guess) {
+std::vector<double> velocity_of(VerifiedScene& x, const double* q, const double* p, std::vector<double> guess) {
   x.lagrangian.inverse_legendre(q, p, guess.data(), x.scene.solver);
   return guess;
 }
 
-std::vector<double> initial_velocity(Context& x) {
+std::vector<double> initial_velocity(VerifiedScene& x) {
   return velocity_of(x, x.a.q0.data(), x.a.p0.data(), std::vector<double>(x.n, 0.0));
 }
 
@@ -69,7 +69,7 @@ PropertyCheck defect_check(const char* name, json predicted, const DefectScaling
 }
 
 // The step sizes of a defect measurement: the scene's step times 2^k for k in `powers`.
-std::vector<double> steps_of(const Context& x, std::initializer_list<int> powers) {
+std::vector<double> steps_of(const VerifiedScene& x, std::initializer_list<int> powers) {
   std::vector<double> h;
   for (int k : powers) h.push_back(std::ldexp(x.scene.step, k));
   return h;
@@ -119,7 +119,7 @@ PropertyCheck defect_check(const char* name, json predicted, const DefectValues&
 // a defect of the construction shrinks with h, round-off does not.
 
 // For a one-step map without L_d: Phi_{-h}(Phi_h(x)) = x exactly when the map is self-adjoint.
-double map_symmetry_residual(Context& x, double h) {
+double map_symmetry_residual(VerifiedScene& x, double h) {
   std::vector<double> q1(x.m), p1(x.n), q2(x.m), p2(x.n);
   x.a.map->step(x.a.q0.data(), x.a.p0.data(), x.a.t0, h, q1.data(), p1.data());
   x.a.map->step(q1.data(), p1.data(), x.a.t0 + h, -h, q2.data(), p2.data());
@@ -135,7 +135,7 @@ double map_symmetry_residual(Context& x, double h) {
 constexpr double kSpread = 100.0, kSolverSpread = 10.0;
 
 template <class F>
-DefectValues ld_defect(Context& x, const char* property, const std::vector<double>& hs, F&& residual) {
+DefectValues ld_defect(VerifiedScene& x, const char* property, const std::vector<double>& hs, F&& residual) {
   const auto v = initial_velocity(x);
   return defect_values(property, hs, kSpread * kEpsilon, [&](double h, double& noise) {
     const auto pairs = sample_pairs(*x.a.manifold, x.a.q0.data(), v.data(), h, kPairs);
@@ -148,7 +148,7 @@ DefectValues ld_defect(Context& x, const char* property, const std::vector<doubl
   });
 }
 
-PropertyCheck self_adjoint(Context& x) {
+PropertyCheck self_adjoint(VerifiedScene& x) {
   const json predicted = prediction(x.predictions.self_adjoint);
   const auto hs = steps_of(x, {2, 1, 0, -1});
   if (x.a.discrete_lagrangian == nullptr) {
@@ -166,7 +166,7 @@ PropertyCheck self_adjoint(Context& x) {
                       "L_d's measured round-off, or 10 times what the solver's tolerance may leave in L_d)");
 }
 
-PropertyCheck g_invariant(Context& x) {
+PropertyCheck g_invariant(VerifiedScene& x) {
   const json predicted = prediction(x.predictions.g_invariant);
   if (!declares_symmetry(*x.a.lagrangian))
     return not_measured("g_invariant", predicted, "the Lagrangian declares no symmetry group");
@@ -187,7 +187,7 @@ PropertyCheck g_invariant(Context& x) {
 
 // The mass of each degree of freedom at (q, v): the diagonal of d^2 L / dv^2 (1 where that is not a
 // positive number).
-std::vector<double> masses(Context& x, const double* q, const double* v) {
+std::vector<double> masses(VerifiedScene& x, const double* q, const double* v) {
   std::vector<double> mass(x.n, 1.0), gradient(x.m + x.n);
   auto keep = [&](int j, double value) {
     if (std::isfinite(value) && value > 0.0) mass[j] = value;
@@ -212,7 +212,7 @@ std::vector<double> masses(Context& x, const double* q, const double* v) {
 // (its mass times the state's largest speed; 1 at rest) in each momentum. Unit steps would move
 // Pluto (1e-8 solar masses) at 1e5 AU a day and measure nothing but that (the outer solar system's
 // defect read 10.5 against a noise floor of 45).
-Eigen::VectorXd difference_steps(Context& x) {
+Eigen::VectorXd difference_steps(VerifiedScene& x) {
   const auto v0 = initial_velocity(x);
   const auto mass = masses(x, x.a.q0.data(), v0.data());
   auto scale_of = [](double largest) { return largest > 0.0 ? largest : 1.0; };
@@ -223,7 +223,7 @@ Eigen::VectorXd difference_steps(Context& x) {
   return steps;
 }
 
-PropertyCheck symplectic(Context& x) {
+PropertyCheck symplectic(VerifiedScene& x) {
   const Eigen::VectorXd steps = difference_steps(x);
   const auto d = defect_values("symplectic", steps_of(x, {1, 0, -1}), kNoiseSpread * kEpsilon, [&](double h, double& noise) {
     const auto defect = symplecticity_defect(*x.a.map, *x.a.manifold, x.a.q0.data(), x.a.p0.data(), h, steps);
@@ -245,7 +245,7 @@ struct LongRun {
   double momentum_error = 0.0;  // max |J - J0| / max(1, |J0|)
 };
 
-LongRun long_run(Context& x, double h, long steps) {
+LongRun long_run(VerifiedScene& x, double h, long steps) {
   LongRun r{h, {}, 0.0};
   const int k = x.a.lagrangian->momentum_size();
   std::vector<double> J(std::max(k, 0)), J0(J.size()), v(x.n, 0.0);
@@ -268,7 +268,7 @@ LongRun long_run(Context& x, double h, long steps) {
   return r;
 }
 
-PropertyCheck momentum_conserved(Context& x, const std::vector<LongRun>& runs) {
+PropertyCheck momentum_conserved(VerifiedScene& x, const std::vector<LongRun>& runs) {
   const json predicted = prediction(x.predictions.momentum_conserved);
   if (x.a.lagrangian->momentum_size() <= 0)
     return not_measured("momentum_conserved", predicted, "the Lagrangian declares no momentum map");
@@ -282,7 +282,7 @@ PropertyCheck momentum_conserved(Context& x, const std::vector<LongRun>& runs) {
 
 // A drift: the energy error is mostly trend (EnergyDrift::share above kDriftShare) and the trend
 // shrinks with h as a method's error does (round-off and a solver tolerance do not shrink).
-PropertyCheck energy_bounded(Context& x, const std::vector<LongRun>& runs) {
+PropertyCheck energy_bounded(VerifiedScene& x, const std::vector<LongRun>& runs) {
   const EnergyDrift coarse = energy_drift(runs[0].energy_error), fine = energy_drift(runs[1].energy_error);
   // Round-off of the energy: a random walk of kSpread eps |E| per step over the longer run.
   const double E = x.lagrangian.energy(x.a.q0.data(), initial_velocity(x).data());
@@ -317,7 +317,7 @@ bool PropertyCheck::unmeasured() const {
 
 std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& a, Registry& registry,
                                         const std::vector<double>& h) {
-  Context x{scene, a, registry, LagrangianEvaluator(*a.lagrangian), scene.construction->predict(scene, a),
+  VerifiedScene x{scene, a, registry, LagrangianEvaluator(*a.lagrangian), scene.construction->predict(scene, a),
             a.manifold->dim(), a.manifold->point_size(), h};
   std::vector<PropertyCheck> checks{self_adjoint(x), g_invariant(x), ld_order(x), global_order(x)};
   const std::vector<LongRun> runs{long_run(x, scene.step, kLongRun), long_run(x, scene.step / 2, 2 * kLongRun)};

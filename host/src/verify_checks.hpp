@@ -24,8 +24,8 @@ constexpr double kEpsilon = std::numeric_limits<double>::epsilon();
 // The pairs near the diagonal at which identities of L_d and its round-off are sampled (sample_pairs).
 constexpr int kPairs = 5;
 
-// Everything a check needs besides the scene's own integrator.
-struct Context {
+// The scene being verified: everything a check needs besides the scene's own integrator.
+struct VerifiedScene {
   const Scene& scene;
   Assembly& a;
   Registry& registry;
@@ -63,11 +63,11 @@ auto within(const char* property, double h, F&& measure) {
 }
 
 // The velocity at (q, p) (the inverse Legendre transform from `guess`), and at the initial state.
-std::vector<double> velocity_of(Context& x, const double* q, const double* p, std::vector<double> guess);
-std::vector<double> initial_velocity(Context& x);
+std::vector<double> velocity_of(VerifiedScene& x, const double* q, const double* p, std::vector<double> guess);
+std::vector<double> initial_velocity(VerifiedScene& x);
 
 // The order checks (verify_orders.cpp).
-PropertyCheck ld_order(Context& x);
-PropertyCheck global_order(Context& x);
+PropertyCheck ld_order(VerifiedScene& x);
+PropertyCheck global_order(VerifiedScene& x);
 
 }  // namespace varia::host::verify_checks

@@ -31,7 +31,7 @@ constexpr double kAsymptoticSpread = 1.0;
 constexpr double kOrderSpan = 20.0;     // global_order: the final time in scene steps
 constexpr double kRaise = 16.0;         // the order ladders may rise this far above their start
 
-std::shared_ptr<Quadrature> gauss_legendre(Context& x, int points) {
+std::shared_ptr<Quadrature> gauss_legendre(VerifiedScene& x, int points) {
   return x.registry.create_as<Quadrature>("quadrature", "gauss-legendre", json{{"points", points}},
                                           sdk::Context{x.scene.manifold.type, x.m, x.n});
 }
@@ -39,7 +39,7 @@ std::shared_ptr<Quadrature> gauss_legendre(Context& x, int points) {
 // A Galerkin construction of the scene's system (forces included) of the given degree with
 // `points` Gauss-Legendre points, as a reference (constructions/galerkin.cpp): on a Lie group in the
 // natural chart. It is both a discrete Lagrangian and its discrete Hamiltonian map.
-Assembly reference_galerkin(Context& x, int degree, int points) {
+Assembly reference_galerkin(VerifiedScene& x, int degree, int points) {
   return assemble(galerkin_reference(x.scene, degree, points), x.registry);
 }
 
@@ -171,7 +171,7 @@ std::vector<double> generic_velocity(std::vector<double> v, int base) {
   return v;
 }
 
-ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& reference) {
+ExactLd exact_ld(VerifiedScene& x, std::shared_ptr<Quadrature>& fine, Assembly& reference) {
   const auto v0 = initial_velocity(x);
   ExactLd exact;
   if (x.a.lagrangian->has_exact_solution()) {
@@ -208,7 +208,7 @@ ExactLd exact_ld(Context& x, std::shared_ptr<Quadrature>& fine, Assembly& refere
 
 // The order ladder's start and ceiling: the scene's step (twice it for L_d, whose error is local)
 // and kRaise times that; `property` measured at each step size (stop_before it).
-OrderFit ladder(Context& x, const char* property, const ErrorAt& error_at, double top, double floor,
+OrderFit ladder(VerifiedScene& x, const char* property, const ErrorAt& error_at, double top, double floor,
                 const NoiseAt& noise_at = {}) {
   const ErrorAt stopping = [&](double& h) {
     stop_before(property, h);
@@ -221,7 +221,7 @@ OrderFit ladder(Context& x, const char* property, const ErrorAt& error_at, doubl
 
 // The slope of |L_d - L_d^E| / (h |L|) against h: the order of L_d (paper, sec. 1: variational
 // error analysis), its round-off a relative 1000 eps.
-PropertyCheck ld_order(Context& x) {
+PropertyCheck ld_order(VerifiedScene& x) {
   if (x.a.discrete_lagrangian == nullptr)
     return not_measured("ld_order", nullptr, "this construction has no discrete Lagrangian");
   if (const auto& p = x.predictions.ld_order; p && *p >= 2 * kReferenceDegree && !x.a.lagrangian->has_exact_solution()) {
@@ -293,7 +293,7 @@ double largest_magnitude(const std::vector<double>& values) {
   return largest;
 }
 
-double state_distance(Context& x, const double* q, const double* p, const double* qe, const double* pe) {
+double state_distance(VerifiedScene& x, const double* q, const double* p, const double* qe, const double* pe) {
   std::vector<double> xi(x.n);
   check(*x.a.manifold, x.a.manifold->local(qe, q, xi.data()), "local");
   double d = 0.0;
@@ -301,7 +301,7 @@ double state_distance(Context& x, const double* q, const double* p, const double
   return d;
 }
 
-void final_state(DiscreteHamiltonianMap& map, Context& x, double h, long steps, std::vector<double>& q,
+void final_state(DiscreteHamiltonianMap& map, VerifiedScene& x, double h, long steps, std::vector<double>& q,
                  std::vector<double>& p) {
   run(map, x.a.q0, x.a.p0, x.a.t0, h, steps,
       [&](long k, const double* qk, const double* pk) {
@@ -313,7 +313,7 @@ void final_state(DiscreteHamiltonianMap& map, Context& x, double h, long steps, 
 // closed-form solution, else a run of a Galerkin construction of order 8 of the same system
 // (degree 4, 4 Gauss-Legendre points, the scene's forces; in the natural chart on a Lie group)
 // with `steps` steps, whose change on doubling them is returned as its uncertainty.
-std::string reference_state(Context& x, double T, long steps, std::vector<double>& q, std::vector<double>& p,
+std::string reference_state(VerifiedScene& x, double T, long steps, std::vector<double>& q, std::vector<double>& p,
                             double& uncertainty) {
   q.resize(x.m);
   p.resize(x.n);
@@ -347,7 +347,7 @@ double top_step(const Scene& scene, const std::vector<double>& given_h) {
 
 // The slope of the error at T = kOrderSpan top steps against h (each h made a whole number of
 // steps to T).
-PropertyCheck global_order(Context& x) {
+PropertyCheck global_order(VerifiedScene& x) {
   const double top = top_step(x.scene, x.given_h);
   const double T = kOrderSpan * top;
   std::vector<double> qe, pe, q, p;

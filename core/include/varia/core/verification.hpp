@@ -122,9 +122,9 @@ void exact_discrete_lagrangian(LagrangianEvaluator& lagrangian, const double* no
 
 // Runs `steps` steps of size h from (q, p) at time t0 through the trajectory driver
 // (trajectory.hpp), calling observe(k, q, p) at every step (k = 0 first).
-using Observer = std::function<void(long, const double*, const double*)>;
+using StateVisitor = std::function<void(long, const double*, const double*)>;
 void run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::VectorXd& p, double t0, double h,
-         long steps, const Observer& observe);
+         long steps, const StateVisitor& observe);
 
 // The one-step map's Jacobian M = d(xi1, pi1)/d(xi0, pi0) in canonical coordinates of T*Q (the
 // natural chart at q0 and its conjugate momenta pi = dexp_{-xi}^T p; (q, p) on a vector space), by
