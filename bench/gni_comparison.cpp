@@ -10,7 +10,8 @@
 //   - Stormer-Verlet through `varia run`'s driver against odeint's velocity_verlet, 10^6 steps;
 //   - SVIRK4 (shooting with rk4 and Simpson's rule) per step against gni_irk2 s = 2 per step, and
 //     against the same method written by hand for the pendulum (svirk4_by_hand.hpp), its floor;
-//   - Lie group Galerkin on SO(3), s = 2, per step against the Lie group velocity Verlet;
+//   - Lie group Galerkin on SO(3), s = 2, per step against the Lie group velocity Verlet, and the
+//     explicit midpoint and Crouch-Grossman shooting beside it (a note);
 //   - the Lie group velocity Verlet through `varia run` observing energy, momentum and
 //     orthogonality against the same run observing nothing.
 // varia's times are the fastest of repeated runs of its stepping loop (host::run_timed) or of
@@ -281,6 +282,23 @@ void lie_group(varia::host::Registry& registry) {
   in_turns(g, l, [&] { return per_step(galerkin); }, [&] { return per_step(lgvi); });
   rows.push_back({"Lie group Galerkin on SO(3), s = 2 (2 Gauss points), rigid body, h = 0.05", ns(g),
                   fmt::format("Lie group velocity Verlet {}", ns(l)), g / l, 15.0});
+  // The Lie group one-step methods on the Euler-Poincare field, alone and inside shooting: per step
+  // against the same velocity Verlet, no bar.
+  VariaMethod midpoint = make_varia(
+      registry, "varia explicit midpoint on SO(3)",
+      rigid_body_scene({{"construction", "one-step"}, {"one_step", {{"type", "explicit-midpoint"}}}}, h, steps,
+                       json::array()));
+  VariaMethod crouch_grossman = make_varia(
+      registry, "varia Crouch-Grossman shooting on SO(3)",
+      rigid_body_scene({{"construction", "shooting"},
+                        {"one_step", {{"type", "crouch-grossman"}, {"order", 2}}},
+                        {"quadrature", {{"type", "trapezoid"}}}},
+                       h, steps, json::array()));
+  const double e = per_step(midpoint), c = per_step(crouch_grossman);
+  notes.push_back(fmt::format("Lie group one-step methods on SO(3), rigid body, h = 0.05: explicit midpoint {} "
+                              "({:.2f}x Lie group velocity Verlet), Crouch-Grossman order 2 + trapezoid shooting {} "
+                              "({:.0f}x)",
+                              ns(e), e / l, ns(c), c / l));
 
   const long run_steps = 20000;
   VariaMethod observed = make_varia(registry, "LGVI observing",

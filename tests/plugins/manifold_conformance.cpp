@@ -128,3 +128,28 @@ TEST_CASE("the Lie group conformance suite refuses a chart whose gradient withou
   } honest;
   CHECK(varia::sdk::conformance::check_lie_group(honest, q, engine).empty());
 }
+
+TEST_CASE("SO3 and SE3 give their generators at a point (constant jets, composed in doubles) equal to the bit to the "
+          "values of the generators at jets of the point's numbers") {
+  std::mt19937 engine(20261128);
+  const Eigen::VectorXd rotation = (Eigen::VectorXd(9) << 1, 0, 0, 0, 1, 0, 0, 0, 1).finished();
+  const Eigen::VectorXd motion = (Eigen::VectorXd(12) << 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.3, -2, 5).finished();
+  for (const auto& [type, identity] : {std::pair{"SO3", rotation}, std::pair{"SE3", motion}}) {
+    CAPTURE(type);
+    auto file = load_plugin("manifold", type);
+    auto manifold = file.create<varia::Manifold>(json::object(), json::object());
+    const int m = manifold->point_size(), n = manifold->dim();
+    const Eigen::VectorXd g = random_point(*manifold, identity, engine);
+    std::vector<varia::Jet2> at_point(m), at_jets(m), D_point(m * n), D_jets(m * n);
+    for (int k = 0; k < m; ++k) at_point[k] = varia::Jet2(g[k]), at_jets[k] = varia::Jet2::variable(g[k], m, k);
+    REQUIRE(manifold->generators(at_point.data(), D_point.data()) == nullptr);
+    REQUIRE(manifold->generators(at_jets.data(), D_jets.data()) == nullptr);
+    int differing = 0, constant = 0;
+    for (int i = 0; i < m * n; ++i) {
+      differing += D_point[i].value != D_jets[i].value;
+      constant += D_point[i].constant();
+    }
+    CHECK(differing == 0);
+    CHECK(constant == m * n);
+  }
+}

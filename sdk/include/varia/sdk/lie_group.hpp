@@ -221,12 +221,25 @@ class LieGroupManifold : public Manifold {
 
   Status generators(const Jet2* q, Jet2* D) noexcept override {
     return guarded(error_, [&] {
+      if (std::all_of(q, q + m, [](const Jet2& x) { return x.constant(); })) return generators_at_point(q, D);
       for (int a = 0; a < n; ++a) {
         for (int k = 0; k < m; ++k) xs_[k] = Jet2(unit_[k] + tangents_[k * n + a]);
         Group::compose(q, xs_.data(), ys_.data());
         for (int k = 0; k < m; ++k) D[k * n + a] = ys_[k] - q[k];
       }
     });
+  }
+
+  // At a point (constant jets: the Euler-Poincare field at doubles, an explicit method's stages) the
+  // same compositions in doubles, which give the same values without a jet's derivatives to carry.
+  void generators_at_point(const Jet2* q, Jet2* D) const {
+    std::array<double, m> point, unit_plus_tangent, moved;
+    for (int k = 0; k < m; ++k) point[k] = q[k].value;
+    for (int a = 0; a < n; ++a) {
+      for (int k = 0; k < m; ++k) unit_plus_tangent[k] = unit_[k] + tangents_[k * n + a];
+      Group::compose(point.data(), unit_plus_tangent.data(), moved.data());
+      for (int k = 0; k < m; ++k) D[k * n + a] = Jet2(moved[k] - point[k]);
+    }
   }
 
   // ad*_xi mu = (ad_xi)^T mu: component j is <mu, [xi, e_j]>.
