@@ -5,6 +5,8 @@
 #include <doctest/doctest.h>
 
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "load_plugin.hpp"
 #include "varia/sdk/conformance/manifold.hpp"
@@ -83,13 +85,17 @@ class LyingLine final : public varia::sdk::LieGroupManifold<Line> {
   }
 };
 
+// The bundled Lie groups, each with a point of it to start random points from (SE3's translated).
+std::vector<std::pair<const char*, Eigen::VectorXd>> bundled_groups() {
+  return {{"SO3", (Eigen::VectorXd(9) << 1, 0, 0, 0, 1, 0, 0, 0, 1).finished()},
+          {"SE3", (Eigen::VectorXd(12) << 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.3, -2, 5).finished()}};
+}
+
 }  // namespace
 
 TEST_CASE("the Lie group conformance suite passes SO3 and SE3 at random points, with the generators' Taylor test") {
   std::mt19937 engine(20261124);
-  const Eigen::VectorXd rotation = (Eigen::VectorXd(9) << 1, 0, 0, 0, 1, 0, 0, 0, 1).finished();
-  const Eigen::VectorXd motion = (Eigen::VectorXd(12) << 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.3, -2, 5).finished();
-  for (const auto& [type, identity] : {std::pair{"SO3", rotation}, std::pair{"SE3", motion}}) {
+  for (const auto& [type, identity] : bundled_groups()) {
     CAPTURE(type);
     auto file = load_plugin("manifold", type);
     auto manifold = file.create<varia::Manifold>(json::object(), json::object());
@@ -132,9 +138,7 @@ TEST_CASE("the Lie group conformance suite refuses a chart whose gradient withou
 TEST_CASE("SO3 and SE3 give their generators at a point (constant jets, composed in doubles) equal to the bit to the "
           "values of the generators at jets of the point's numbers") {
   std::mt19937 engine(20261128);
-  const Eigen::VectorXd rotation = (Eigen::VectorXd(9) << 1, 0, 0, 0, 1, 0, 0, 0, 1).finished();
-  const Eigen::VectorXd motion = (Eigen::VectorXd(12) << 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.3, -2, 5).finished();
-  for (const auto& [type, identity] : {std::pair{"SO3", rotation}, std::pair{"SE3", motion}}) {
+  for (const auto& [type, identity] : bundled_groups()) {
     CAPTURE(type);
     auto file = load_plugin("manifold", type);
     auto manifold = file.create<varia::Manifold>(json::object(), json::object());
