@@ -44,7 +44,7 @@ Json chain_scene(int particles) {
 
 // Seconds per step, after one step that analyses the sparsity pattern.
 double seconds_per_step(int particles, int steps, varia::host::Registry& registry) {
-  const varia::host::Scene scene = varia::host::parse_scene(chain_scene(particles));
+  varia::host::Scene scene = varia::host::parse_scene(chain_scene(particles));
   varia::host::validate_parameters(scene, registry);
   varia::host::Assembly a = varia::host::assemble(scene, registry);
   varia::Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, scene.step);

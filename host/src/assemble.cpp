@@ -6,7 +6,6 @@
 
 #include "constructions/parts.hpp"
 #include "registry.hpp"
-#include "varia/core/composite.hpp"
 #include "varia/core/mechanics.hpp"
 
 namespace varia::host {
@@ -94,31 +93,6 @@ void initial_state(const Scene& scene, Assembly& a) {
   evaluator.inverse_legendre(a.q0.data(), a.p0.data(), a.v0.data(), scene.solver);
 }
 
-// Spec "Composed systems": the host creates the effect plugin of each term and builds the composite
-// in core (varia/core/composite.hpp), so that no plugin calls another; the composite plugin itself
-// carries the type's metadata and schema (docs/effects.md).
-std::shared_ptr<Lagrangian> composite(const Scene& scene, Registry& registry, const sdk::Context& context) {
-  std::vector<std::shared_ptr<Effect>> effects;
-  for (const auto& spec : scene.effects)
-    effects.push_back(make_part<Effect>(registry, spec, context));
-  const auto& parameters = scene.lagrangian.parameters;
-  try {
-    auto made = std::make_shared<CompositeLagrangian>(parameters.value("space_dim", 1),
-                                                      parameters.value("masses", std::vector<double>{1.0}),
-                                                      std::move(effects));
-    made->set_origin(&registry.find(scene.lagrangian.kind, scene.lagrangian.type));
-    return made;
-  } catch (const std::invalid_argument& e) {
-    throw InputError(fmt::format("{}/{}", scene.lagrangian.pointer, e.what()));
-  }
-}
-
-std::shared_ptr<Lagrangian> lagrangian(const Scene& scene, Registry& registry, const Manifold& manifold) {
-  const sdk::Context context = context_of(scene, manifold);
-  if (scene.lagrangian.type == "composite") return composite(scene, registry, context);
-  return make_part<Lagrangian>(registry, scene.lagrangian, scene, manifold);
-}
-
 }  // namespace
 
 void check_momentum_size(const Lagrangian& lagrangian, int dim) {
@@ -169,11 +143,11 @@ bool has_exact_solution(const Assembly& a) { return a.forces.empty() && a.lagran
 Assembly assemble(const Scene& scene, Registry& registry) {
   Assembly a;
   // The manifold first: its sizes go into the context of the others (Rn reads its "dim").
-  a.manifold = make_part<Manifold>(registry, scene.manifold, sdk::Context{scene.manifold.type, 0, 0});
+  a.manifold = make_part<Manifold>(registry, scene.manifold, sdk::Context{manifold_name(scene.manifold), 0, 0});
   check_declared_sizes(*a.manifold);
   check_structure_served(scene, *a.manifold);
   check_initial_state(scene, *a.manifold, scene.manifold.type);
-  a.lagrangian = lagrangian(scene, registry, *a.manifold);
+  a.lagrangian = make_part<Lagrangian>(registry, scene.lagrangian, scene, *a.manifold);
   check_declared_sizes(*a.lagrangian);
   check_lagrangian_fits(scene, *a.lagrangian, *a.manifold);
   check_momentum_size(*a.lagrangian, a.manifold->dim());

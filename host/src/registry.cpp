@@ -43,6 +43,9 @@ struct Refused {
   std::string reason;
 };
 
+constexpr Kind kKinds[] = {Kind::manifold, Kind::quadrature, Kind::lagrangian,
+                           Kind::one_step, Kind::effect,     Kind::force};
+
 std::string kind_name(Kind kind) {
   switch (kind) {
     case Kind::manifold: return "manifold";
@@ -112,11 +115,14 @@ nlohmann::json parameter_schema(const char* text) {
   return schema;
 }
 
-// Deletes a plugin's object, then releases the object's hold on the library that made it.
+// Deletes a plugin's object, then the parts it borrowed, then releases the object's hold on the
+// library that made it.
 struct PluginDeleter {
   std::shared_ptr<boost::dll::shared_library> library;
+  std::vector<MadePart> parts;
   void operator()(PluginObject* object) {
     delete object;
+    parts.clear();
     library.reset();
   }
 };
@@ -126,6 +132,7 @@ struct PluginDeleter {
 struct Registry::Loaded {
   std::shared_ptr<boost::dll::shared_library> library;
   sdk::CreateFunction* create = nullptr;
+  sdk::CreateWithPartsFunction* create_with_parts = nullptr;  // null for a plugin without part roles
   PluginRecord record;
 };
 
@@ -165,6 +172,25 @@ void check_abi(const boost::dll::shared_library& library) {
     throw Refused{fmt::format("ABI version {}, this host speaks {}", version, kAbiVersion)};
 }
 
+// The parameters a plugin's schema marks "x-varia-part": "<kind>", its part roles.
+std::vector<PartRole> part_roles(const nlohmann::json& schema) {
+  std::vector<PartRole> roles;
+  const auto properties = schema.find("properties");
+  if (properties == schema.end() || !properties->is_object()) return roles;
+  for (const auto& [name, property] : properties->items()) {
+    const auto mark = property.is_object() ? property.find("x-varia-part") : property.end();
+    if (!property.is_object() || mark == property.end()) continue;
+    const bool known = mark->is_string() && std::any_of(std::begin(kKinds), std::end(kKinds), [&](Kind k) {
+      return kind_name(k) == mark->get<std::string>();
+    });
+    if (!known)
+      throw Refused{fmt::format("its parameter_schema marks '{}' as parts of kind {}, which is not a plugin kind",
+                                name, mark->dump())};
+    roles.push_back(PartRole{name, mark->get<std::string>()});
+  }
+  return roles;
+}
+
 PluginRecord read_info(const boost::dll::shared_library& library, const fs::path& file) {
   if (!library.has("varia_info")) throw Refused{"missing metadata (no varia_info)"};
   const sdk::PluginInfo* info = library.get_alias<sdk::InfoFunction>("varia_info")();
@@ -172,8 +198,9 @@ PluginRecord read_info(const boost::dll::shared_library& library, const fs::path
       info->version == nullptr || info->parameter_schema == nullptr || info->properties == nullptr)
     throw Refused{"missing metadata (varia_info has an empty field)"};
   PluginRecord record{file, info->kind, info->type, info->version, parameter_schema(info->parameter_schema),
-                      parse_metadata(info->properties, "properties"), {}};
+                      parse_metadata(info->properties, "properties"), {}, {}};
   record.declared = declared_properties(record.properties);
+  record.part_roles = part_roles(record.parameter_schema);
   return record;
 }
 
@@ -201,6 +228,13 @@ std::shared_ptr<Registry::Loaded> Registry::load(const fs::path& file, const Sym
                                 record.kind, record.type)};
     if (!loaded->library->has("varia_create")) throw Refused{"no varia_create factory"};
     loaded->create = &loaded->library->get_alias<sdk::CreateFunction>("varia_create");
+    if (!record.part_roles.empty()) {
+      if (!loaded->library->has("varia_create_parts"))
+        throw Refused{fmt::format("its parameter_schema declares parts ('{}') but it exports no varia_create_parts "
+                                  "factory to take them",
+                                  record.part_roles.front().role)};
+      loaded->create_with_parts = &loaded->library->get_alias<sdk::CreateWithPartsFunction>("varia_create_parts");
+    }
     return loaded;
   } catch (const Refused& refused) {
     throw PluginLoadError(fmt::format("{}: {}", file.string(), refused.reason));
@@ -367,9 +401,25 @@ const PluginRecord& Registry::find(const std::string& kind, const std::string& t
   return loaded_.emplace(key, std::move(loaded)).first->second->record;
 }
 
+// The part a plugin's failure names first ("terms/2: ..."), whose plugin is then at fault.
+std::optional<std::reference_wrapper<const PluginRecord>> Registry::part_named(const std::vector<MadePart>& parts,
+                                                                               std::string_view message) {
+  const std::size_t slash = message.find('/'), colon = message.find(": ");
+  if (slash == std::string_view::npos || colon == std::string_view::npos || slash > colon) return std::nullopt;
+  const std::string_view role = message.substr(0, slash), index = message.substr(slash + 1, colon - slash - 1);
+  if (index.empty() || index.size() > 9 ||
+      !std::all_of(index.begin(), index.end(), [](char c) { return std::isdigit(c) != 0; }))
+    return std::nullopt;
+  std::size_t wanted = std::stoul(std::string(index)), seen = 0;
+  for (const MadePart& part : parts)
+    if (part.role == role && seen++ == wanted && part.object->origin() != nullptr)
+      return std::cref(record_of(part.object->origin()));
+  return std::nullopt;
+}
+
 std::shared_ptr<PluginObject> Registry::create(const std::string& kind, const std::string& type,
                                                const nlohmann::json& parameters,
-                                               const sdk::Context& context) {
+                                               const sdk::Context& context, std::vector<MadePart> parts) {
   const PluginRecord& record = find(kind, type);
   const Loaded& loaded = *loaded_.at(kind + "/" + type);
   const std::string parameter_text = parameters.dump();
@@ -377,14 +427,21 @@ std::shared_ptr<PluginObject> Registry::create(const std::string& kind, const st
       nlohmann::json{{"manifold", context.manifold}, {"point_size", context.point_size}, {"dim", context.dim}}
           .dump();
   char error[1024] = {};
-  PluginObject* object = loaded.create(parameter_text.c_str(), context_text.c_str(), error, sizeof error);
+  std::vector<Part> borrowed;
+  for (const MadePart& part : parts) borrowed.push_back(Part{part.role.c_str(), part.object.get()});
+  PluginObject* object =
+      loaded.create_with_parts != nullptr
+          ? loaded.create_with_parts(parameter_text.c_str(), context_text.c_str(), borrowed.data(),
+                                     static_cast<int>(borrowed.size()), error, sizeof error)
+          : loaded.create(parameter_text.c_str(), context_text.c_str(), error, sizeof error);
   if (object == nullptr) {
     if (const char* refused = refused_parameter(error))
       throw InputError(fmt::format("{} (the {} plugin {})", refused, type, record.file.filename().string()));
-    throw PluginLoadError(fmt::format("{}: {}: {}", record.file.string(), type,
+    const PluginRecord& at_fault = part_named(parts, error).value_or(record);
+    throw PluginLoadError(fmt::format("{}: {}: {}", at_fault.file.string(), at_fault.type,
                                       error[0] != '\0' ? error : "the plugin made no object"));
   }
-  std::shared_ptr<PluginObject> owned(object, PluginDeleter{loaded.library});
+  std::shared_ptr<PluginObject> owned(object, PluginDeleter{loaded.library, std::move(parts)});
   owned->set_origin(&record);
   if (kind_name(owned->kind()) != kind)
     throw PluginLoadError(fmt::format("{}: {}: made an object of kind {}, not {}", record.file.string(),

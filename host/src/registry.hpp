@@ -10,11 +10,13 @@
 #pragma once
 
 #include <filesystem>
+#include <functional>
 #include <map>
 #include <memory>
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "errors.hpp"
@@ -30,11 +32,24 @@ struct DeclaredProperties {
   bool symplectic = false;  // a one-step method's "symplectic" (in canonical coordinates)
 };
 
+// A parameter whose value the host makes into plugin objects of `kind`, the plugin's parts of this
+// role (abi/plugin_object.hpp, Part): its schema property carries "x-varia-part": "<kind>".
+struct PartRole {
+  std::string role, kind;
+};
+
 struct PluginRecord {
   std::filesystem::path file;
   std::string kind, type, version;
   nlohmann::json parameter_schema, properties;
   DeclaredProperties declared;
+  std::vector<PartRole> part_roles;
+};
+
+// An object made for a role of another's parameters, which the made object borrows.
+struct MadePart {
+  std::string role;
+  std::shared_ptr<PluginObject> object;
 };
 
 struct Refusal {
@@ -78,13 +93,16 @@ class Registry {
   // object (its "type" key removed), already validated against the plugin's schema. Throws
   // InputError "<message> (the <type> plugin <file name>)" when the plugin refuses a parameter value
   // (kRefusedParameter), PluginLoadError "<file>: <type>: <message>" when it fails otherwise.
+  // `parts` are the objects made from the parameters of its part roles; the made object keeps them
+  // alive.
   std::shared_ptr<PluginObject> create(const std::string& kind, const std::string& type,
-                                       const nlohmann::json& parameters,
-                                       const sdk::Context& context);
+                                       const nlohmann::json& parameters, const sdk::Context& context,
+                                       std::vector<MadePart> parts = {});
   template <class T>
   std::shared_ptr<T> create_as(const std::string& kind, const std::string& type,
-                               const nlohmann::json& parameters, const sdk::Context& context) {
-    return std::static_pointer_cast<T>(create(kind, type, parameters, context));
+                               const nlohmann::json& parameters, const sdk::Context& context,
+                               std::vector<MadePart> parts = {}) {
+    return std::static_pointer_cast<T>(create(kind, type, parameters, context, std::move(parts)));
   }
   // Type names of the plugins loaded so far, in load order (the run record's plugins_loaded).
   std::vector<std::string> loaded() const;
@@ -102,6 +120,8 @@ class Registry {
   std::vector<std::filesystem::path> files_declaring(const std::string& kind, const std::string& type);
   std::string valid_types(const std::string& kind);
 
+  static std::optional<std::reference_wrapper<const PluginRecord>> part_named(const std::vector<MadePart>& parts,
+                                                                             std::string_view message);
   // The error for a type that only refused (untrusted) files declare, if one does.
   void check_not_refused(const std::string& kind, const std::string& type);
 

@@ -101,10 +101,9 @@ void check_size(const std::vector<double>& values, int expected, const std::stri
 
 }  // namespace
 
-std::vector<const PluginSpec*> Scene::plugins() const {
-  std::vector<const PluginSpec*> all{&manifold, &lagrangian};
-  for (const auto& effect : effects) all.push_back(&effect);
-  for (const auto& force : forces) all.push_back(&force);
+std::vector<PluginSpec*> Scene::plugins() {
+  std::vector<PluginSpec*> all{&manifold, &lagrangian};
+  for (auto& force : forces) all.push_back(&force);
   if (quadrature) all.push_back(&*quadrature);
   if (one_step) all.push_back(&*one_step);
   return all;
@@ -117,12 +116,6 @@ Scene parse_scene(const json& document) {
   const json& system = document["system"];
   scene.manifold = plugin_spec(system["manifold"], "/system/manifold", "manifold");
   scene.lagrangian = plugin_spec(system["lagrangian"], "/system/lagrangian", "lagrangian");
-  // Spec "Composed systems": each of the lagrangian's terms is an effect plugin object (checked to
-  // have a "type" by the lagrangian's parameter schema, before the effects are created).
-  const json terms = scene.lagrangian.parameters.value("terms", json::array());
-  for (std::size_t i = 0; terms.is_array() && i < terms.size(); ++i)
-    if (terms[i].is_object() && terms[i].contains("type") && terms[i]["type"].is_string())
-      scene.effects.push_back(plugin_spec(terms[i], fmt::format("/system/lagrangian/terms/{}", i), "effect"));
   const json forces = system.value("forces", json::array());
   for (std::size_t i = 0; i < forces.size(); ++i)
     scene.forces.push_back(plugin_spec(forces[i], fmt::format("/system/forces/{}", i), "force"));
@@ -140,22 +133,58 @@ Scene parse_scene(const json& document) {
   return scene;
 }
 
-void validate_parameters(const Scene& scene, Registry& registry) {
-  for (const PluginSpec* spec : scene.plugins()) {
-    const PluginRecord* record = nullptr;
-    try {
-      record = &registry.find(spec->kind, spec->type);
-    } catch (const InputError& e) {
-      throw InputError(fmt::format("{}/type: {}", spec->pointer, e.what()));
-    }
-    std::optional<SchemaValidator> validator;
-    try {
-      validator.emplace(record->parameter_schema);
-    } catch (const std::invalid_argument& e) {
-      throw PluginLoadError(fmt::format("{}: parameter_schema: {}", record->file.string(), e.what()));
-    }
-    validator->validate(spec->parameters, spec->pointer);
+namespace {
+
+// A plugin object where a part of `role` must be one: an object with a string "type".
+PluginSpec part_spec(const json& object, const std::string& pointer, const PartRole& role) {
+  if (!object.is_object() || !object.contains("type") || !object["type"].is_string())
+    throw InputError(fmt::format("{}: expected a {} plugin object, with a \"type\"; found {}", pointer, role.kind,
+                                 brief(object)));
+  PluginSpec spec = plugin_spec(object, pointer, role.kind);
+  spec.role = role.role;
+  return spec;
+}
+
+// The parts of spec's plugin among its parameters (a role's value is one plugin object or an array
+// of them), each checked as spec is.
+void validate_spec(PluginSpec& spec, Registry& registry) {
+  const PluginRecord* record = nullptr;
+  try {
+    record = &registry.find(spec.kind, spec.type);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}/type: {}", spec.pointer, e.what()));
   }
+  std::optional<SchemaValidator> validator;
+  try {
+    validator.emplace(record->parameter_schema);
+  } catch (const std::invalid_argument& e) {
+    throw PluginLoadError(fmt::format("{}: parameter_schema: {}", record->file.string(), e.what()));
+  }
+  validator->validate(spec.parameters, spec.pointer);
+  spec.parts.clear();
+  for (const PartRole& role : record->part_roles) {
+    if (!spec.parameters.contains(role.role)) continue;
+    const json& value = spec.parameters[role.role];
+    const std::string pointer = spec.pointer + "/" + role.role;
+    if (!value.is_array()) spec.parts.push_back(part_spec(value, pointer, role));
+    for (std::size_t i = 0; value.is_array() && i < value.size(); ++i)
+      spec.parts.push_back(part_spec(value[i], fmt::format("{}/{}", pointer, i), role));
+  }
+  for (PluginSpec& part : spec.parts) validate_spec(part, registry);
+}
+
+}  // namespace
+
+std::string manifold_name(const PluginSpec& manifold) {
+  if (manifold.parts.empty()) return manifold.type;
+  std::string name = manifold.type + "(";
+  for (std::size_t i = 0; i < manifold.parts.size(); ++i)
+    name += (i > 0 ? "," : "") + manifold_name(manifold.parts[i]);
+  return name + ")";
+}
+
+void validate_parameters(Scene& scene, Registry& registry) {
+  for (PluginSpec* spec : scene.plugins()) validate_spec(*spec, registry);
 }
 
 Scene load_scene(const std::filesystem::path& file, Registry& registry) {

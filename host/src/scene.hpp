@@ -23,7 +23,15 @@ struct PluginSpec {
   std::string kind;           // registry kind, e.g. "lagrangian"
   std::string type;           // e.g. "pendulum"
   nlohmann::json parameters;  // the object's keys minus "type"
+  // The plugin objects among its parameters that its plugin takes as parts (a product's factors,
+  // a composite's terms; registry.hpp, PartRole), found by validate_parameters, each with its role.
+  std::vector<PluginSpec> parts{};
+  std::string role{};  // the parameter this spec is a part of, or empty
 };
+
+// The manifold's name as the plugins' Context gives it: its type, with its parts' names in
+// parentheses ("product(SO3,SO3)").
+std::string manifold_name(const PluginSpec& manifold);
 
 struct Observe {
   bool energy = false, momentum = false, orthogonality = false;
@@ -34,7 +42,6 @@ struct Scene {
   const Construction* construction = nullptr;  // method.construction, from the table
   std::shared_ptr<const MethodOptions> method_options;  // its own keys of "method", read by it
   PluginSpec manifold, lagrangian;
-  std::vector<PluginSpec> effects;  // the lagrangian's "terms" (a composite's effects)
   std::vector<PluginSpec> forces;
   std::optional<PluginSpec> quadrature, one_step;  // the parts a construction names in "method"
   SolverOptions solver;
@@ -46,15 +53,17 @@ struct Scene {
   std::vector<double> q;
   std::optional<std::vector<double>> p, v;  // exactly one is set
 
-  // Every plugin object of the scene, in the order they are created.
-  std::vector<const PluginSpec*> plugins() const;
+  // Every plugin object of the scene outside other plugins' parameters, in the order they are
+  // created (each after its parts).
+  std::vector<PluginSpec*> plugins();
 };
 
 // Checks a scene document against the scene schema and returns its content (InputError).
 Scene parse_scene(const nlohmann::json& document);
-// Checks each plugin object's parameters against its plugin's parameter schema; an unknown type
-// is an InputError naming the object's "type" pointer.
-void validate_parameters(const Scene& scene, Registry& registry);
+// Checks each plugin object's parameters against its plugin's parameter schema, and finds the
+// parts among them (PluginSpec::parts), checked the same way; an unknown type is an InputError
+// naming the object's "type" pointer.
+void validate_parameters(Scene& scene, Registry& registry);
 // read_json_file + parse_scene + validate_parameters.
 Scene load_scene(const std::filesystem::path& file, Registry& registry);
 // Checks initial.q/p/v against the manifold (sizes, contains); InputError naming /initial/...

@@ -1,7 +1,6 @@
-// The composite particle system (spec: "Composed systems: effects"; core/composite.hpp). This
-// plugin carries the type's metadata and parameter schema. The host builds a scene's composite in
-// core from `space_dim`, `masses` and the effect objects it creates from `terms` (docs/effects.md);
-// made directly, as here, the plugin is the system without terms: free particles.
+// The composite particle system (spec: "Composed systems: effects"; core/composite.hpp): its
+// `terms` are its parts, effect objects the host makes from the scene and passes in (the schema's
+// "x-varia-part"), so that no plugin loads another. Made without parts, it is free particles.
 #include <stdexcept>
 
 #include "support.hpp"
@@ -21,6 +20,7 @@ class Composite final : public varia::CompositeLagrangian {
       "masses": {"type": "array", "items": {"type": "number", "exclusiveMinimum": 0}, "minItems": 1,
                  "default": [1], "description": "one mass per particle; n = d x (number of masses)"},
       "terms": {"type": "array", "description": "potential effects, each an effect plugin object",
+                "x-varia-part": "effect",
                 "items": {"type": "object", "required": ["type"],
                           "properties": {"type": {"type": "string", "minLength": 1}}}}
     },
@@ -34,16 +34,26 @@ class Composite final : public varia::CompositeLagrangian {
   })json";
 
   Composite(const nlohmann::json& parameters, const varia::sdk::Context& context)
-      : CompositeLagrangian(parameters.value("space_dim", 1), masses(parameters), {}) {
+      : CompositeLagrangian(parameters.value("space_dim", 1), masses(parameters), terms(parameters, context)) {
     varia::plugins::require_rn(context, "composite", velocity_size(), velocity_size());
-    if (!parameters.value("terms", nlohmann::json::array()).empty())
-      throw std::invalid_argument(
-          "composite: the terms are effect plugins that the host creates; made directly, a composite has no terms");
   }
 
  private:
   static std::vector<double> masses(const nlohmann::json& parameters) {
     return parameters.value("masses", std::vector<double>{1.0});
+  }
+  // The effects the host made from "terms", borrowed: the host keeps them alive as long as this.
+  static std::vector<std::shared_ptr<varia::Effect>> terms(const nlohmann::json& parameters,
+                                                           const varia::sdk::Context& context) {
+    std::vector<std::shared_ptr<varia::Effect>> effects;
+    for (varia::Effect* effect : context.parts_of<varia::Effect>("terms", varia::Kind::effect))
+      effects.emplace_back(effect, [](varia::Effect*) {});
+    if (effects.size() != parameters.value("terms", nlohmann::json::array()).size())
+      throw std::runtime_error("composite: its terms are effect objects that the host makes; it was given " +
+                               std::to_string(effects.size()) + " for " +
+                               std::to_string(parameters.value("terms", nlohmann::json::array()).size()) +
+                               " terms");
+    return effects;
   }
 };
 

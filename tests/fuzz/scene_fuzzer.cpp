@@ -53,7 +53,7 @@ void parameter_schema(const std::string& text) {
 void scene(const std::string& text) {
   static Registry registry({VARIA_PLUGIN_DIR});
   try {
-    const Scene scene = parse_scene(parse_json_text(text));
+    Scene scene = parse_scene(parse_json_text(text));
     validate_parameters(scene, registry);
   } catch (const InputError&) {
   }

@@ -18,7 +18,7 @@ TEST_CASE("a scene holds its construction, steps from t_end, observables and plu
   json document = default_scene();
   document["t_end"] = 0.30000000000000004;  // 3 steps of 0.1 up to rounding
   document["step"] = 0.1;
-  const Scene scene = parse_scene(document);
+  Scene scene = parse_scene(document);
   CHECK(std::string(scene.construction->name()) == "galerkin");
   CHECK(scene.construction->describe(scene) == "galerkin degree 2, quadrature gauss-lobatto {\"points\":3}");
   CHECK(scene.steps == 3);
@@ -69,6 +69,26 @@ TEST_CASE("each schema violation is one line naming its JSON pointer and what wa
     CHECK(message.rfind(c.message, 0) == 0);
     CHECK(message.find('\n') == std::string::npos);
   }
+}
+
+TEST_CASE("the plugin objects a plugin's schema marks as its parts are found, checked and named from the schema") {
+  Registry registry{Registry::search_path({})};
+  Scene chain = parse_scene(json::parse(test::read_file(test::kSourceDir / "scenes" / "multibody" / "rigid-body-chain-3.json")));
+  validate_parameters(chain, registry);
+  REQUIRE(chain.manifold.parts.size() == 3);
+  CHECK(chain.manifold.parts[2].pointer == "/system/manifold/factors/2");
+  CHECK(chain.manifold.parts[2].role == "factors");
+  CHECK(chain.manifold.parts[2].kind == "manifold");
+  CHECK(chain.manifold.parts[2].type == "SO3");
+  CHECK(manifold_name(chain.manifold) == "product(SO3,SO3,SO3)");
+  CHECK(chain.lagrangian.parts.empty());  // its "bodies" are parameters, not plugin objects
+
+  Scene springs = parse_scene(json::parse(test::read_file(test::kSourceDir / "scenes" / "effects" / "spring-chain-gravity.json")));
+  validate_parameters(springs, registry);
+  REQUIRE_FALSE(springs.lagrangian.parts.empty());
+  CHECK(springs.lagrangian.parts[0].pointer == "/system/lagrangian/terms/0");
+  CHECK(springs.lagrangian.parts[0].kind == "effect");
+  CHECK(manifold_name(springs.manifold) == "Rn");
 }
 
 }  // namespace

@@ -2,6 +2,17 @@
 
 namespace varia::host {
 
+std::string refusal_pointer(const PluginSpec& spec, std::string& message) {
+  const std::size_t colon = message.find(": ");
+  const std::string path = message.substr(0, colon);
+  const std::string parameter = path.substr(0, path.find('/'));
+  if (colon == std::string::npos || parameter.empty() || !spec.parameters.is_object() ||
+      !spec.parameters.contains(parameter) || path.find(' ') != std::string::npos)
+    return spec.pointer;
+  message.erase(0, colon + 2);
+  return spec.pointer + "/" + path;
+}
+
 void apply_shared_theorems(const Assembly& a, std::optional<bool> ld_invariant, Predictions& p) {
   if (declares_symmetry(*a.lagrangian)) {
     p.g_invariant = ld_invariant;

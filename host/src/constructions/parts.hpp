@@ -15,17 +15,27 @@
 namespace varia::host {
 
 inline sdk::Context context_of(const Scene& scene, const Manifold& manifold) {
-  return sdk::Context{scene.manifold.type, manifold.point_size(), manifold.dim()};
+  return sdk::Context{manifold_name(scene.manifold), manifold.point_size(), manifold.dim()};
 }
 
-// The plugin object a scene's plugin spec names; a parameter value the plugin refuses is bad input
-// at the spec's JSON pointer.
+// The JSON pointer a plugin's refusal names: the spec's, joined with the parameter path the
+// refusal starts with when it names one of the object's parameters ("terms/1: ..." from a
+// composite, CompositeLagrangian's convention), so that the message points at the value at fault.
+std::string refusal_pointer(const PluginSpec& spec, std::string& message);
+
+// The plugin object a scene's plugin spec names, made after its parts (PluginSpec::parts), which
+// it keeps; a parameter value the plugin refuses is bad input at the spec's JSON pointer.
 template <class T>
 std::shared_ptr<T> make_part(Registry& registry, const PluginSpec& spec, const sdk::Context& context) {
+  std::vector<MadePart> parts;
+  for (const PluginSpec& part : spec.parts)
+    parts.push_back(MadePart{part.role, make_part<PluginObject>(registry, part, context)});
   try {
-    return registry.create_as<T>(spec.kind, spec.type, spec.parameters, context);
+    return registry.create_as<T>(spec.kind, spec.type, spec.parameters, context, std::move(parts));
   } catch (const InputError& e) {
-    throw InputError(spec.pointer + ": " + e.what());
+    std::string message = e.what();
+    const std::string pointer = refusal_pointer(spec, message);
+    throw InputError(pointer + ": " + message);
   }
 }
 template <class T>

@@ -24,7 +24,9 @@ namespace varia {
 // 15: Lagrangian::offers and Lagrangian::run, one entry point for every kernel (kernels.hpp),
 // replacing runs_verlet_steps, verlet_steps, runs_shots and shoot; Manifold::structure(),
 // replacing is_vector_space(). A kernel added or changed later
-// is a new id or version of kernels.hpp, not a new ABI version.
+// is a new id or version of kernels.hpp, not a new ABI version. Exported functions a plugin may
+// add without changing the layout of any interface (varia_create_parts, for parts) are not new
+// versions either: a plugin that lacks one keeps loading, and is refused only where it is needed.
 inline constexpr int kAbiVersion = 15;
 
 using Status = const char*;
@@ -41,6 +43,19 @@ inline const char* refused_parameter(const char* error) {
 
 // The plugin kinds. New kinds are appended; existing ones keep their interfaces.
 enum class Kind { manifold, quadrature, lagrangian, one_step, effect, force };
+
+class PluginObject;
+
+// A part of a composed object (a product's factors, a composite's terms): an object the host made
+// from one of the plugin's parameters, which the plugin's parameter schema marks as parts of a
+// kind ("x-varia-part": "<kind>" on the property, whose value is one plugin object or an array of
+// them). The host passes them by role (the property's name), in the order they appear, to the
+// plugin's factory varia_create_parts; it owns them and keeps them alive as long as the object
+// made from them. A plugin that takes no parts need not export that factory.
+struct Part {
+  const char* role;
+  PluginObject* object;
+};
 
 class PluginObject {
  public:

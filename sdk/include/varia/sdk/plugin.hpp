@@ -14,7 +14,9 @@
 //   varia_type_<kind>__<type>  a marker the host finds in the symbol table without loading the
 //                              file, so that a run loads only the files its scene names;
 //   varia_info                 the metadata, read without constructing anything;
-//   varia_create               the factory; it converts every exception into a message.
+//   varia_create               the factory; it converts every exception into a message;
+//   varia_create_parts         the same factory, given the parts the host made from the
+//                              parameters the schema marks "x-varia-part" (Context::parts_of).
 #pragma once
 
 #include <boost/config.hpp>
@@ -23,6 +25,8 @@
 #include <exception>
 #include <nlohmann/json.hpp>
 #include <string>
+#include <string_view>
+#include <vector>
 
 #include "varia/abi/plugin_object.hpp"
 
@@ -30,9 +34,27 @@ namespace varia::sdk {
 
 // What the host tells a plugin about the rest of the scene when it constructs it.
 struct Context {
-  std::string manifold;  // manifold type name, e.g. "Rn", "SO3"
-  int point_size = 0;    // numbers per configuration point
-  int dim = 0;           // tangent dimension
+  // The manifold's type name, e.g. "Rn", "SO3"; a manifold made of parts is named with its parts,
+  // "product(SO3,SO3)".
+  std::string manifold;
+  int point_size = 0;  // numbers per configuration point
+  int dim = 0;         // tangent dimension
+  // The parts the host made for this object (abi/plugin_object.hpp, Part), borrowed: the host keeps
+  // them alive as long as the object.
+  std::vector<Part> parts{};
+
+  // The parts of one role, which the schema declares of kind `kind`; each is checked to be of it.
+  template <class K>
+  std::vector<K*> parts_of(std::string_view role, Kind kind) const {
+    std::vector<K*> found;
+    for (const Part& part : parts) {
+      if (role != part.role) continue;
+      if (part.object == nullptr || part.object->kind() != kind)
+        throw std::runtime_error("the part '" + std::string(role) + "' the host passed is not of the declared kind");
+      found.push_back(static_cast<K*>(part.object));
+    }
+    return found;
+  }
 };
 
 struct PluginInfo {
@@ -45,6 +67,8 @@ struct PluginInfo {
 
 using CreateFunction = PluginObject*(const char* parameters, const char* context, char* error,
                                      int error_size) noexcept;
+using CreateWithPartsFunction = PluginObject*(const char* parameters, const char* context, const Part* parts,
+                                              int part_count, char* error, int error_size) noexcept;
 using InfoFunction = const PluginInfo*() noexcept;
 
 // Runs f, turning any exception into the Status message kept in `store` (the boundary rule).
@@ -70,15 +94,21 @@ inline void copy_message(const std::string& message, char* out, int size) noexce
 
 inline Context parse_context(const char* text) {
   const auto j = nlohmann::json::parse(text);
-  return Context{j.value("manifold", ""), j.value("point_size", 0), j.value("dim", 0)};
+  Context context;
+  context.manifold = j.value("manifold", "");
+  context.point_size = j.value("point_size", 0);
+  context.dim = j.value("dim", 0);
+  return context;
 }
 
 template <class Class>
-PluginObject* create(const char* parameters, const char* context, char* error,
-                     int error_size) noexcept {
+PluginObject* create_with_parts(const char* parameters, const char* context, const Part* parts, int part_count,
+                                char* error, int error_size) noexcept {
   std::string message;
   try {
-    return new Class(nlohmann::json::parse(parameters), parse_context(context));
+    Context parsed = parse_context(context);
+    parsed.parts.assign(parts, parts + (parts != nullptr && part_count > 0 ? part_count : 0));
+    return new Class(nlohmann::json::parse(parameters), parsed);
   } catch (const std::invalid_argument& e) {  // a parameter value the plugin refuses: bad input
     message = std::string(kRefusedParameter) + e.what();
   } catch (const std::exception& e) {
@@ -88,6 +118,11 @@ PluginObject* create(const char* parameters, const char* context, char* error,
   }
   copy_message(message, error, error_size);
   return nullptr;
+}
+
+template <class Class>
+PluginObject* create(const char* parameters, const char* context, char* error, int error_size) noexcept {
+  return create_with_parts<Class>(parameters, context, nullptr, 0, error, error_size);
 }
 
 }  // namespace varia::sdk
@@ -115,6 +150,12 @@ PluginObject* create(const char* parameters, const char* context, char* error,
                                              int n) noexcept {                               \
     return ::varia::sdk::create<Class>(p, c, e, n);                                          \
   }                                                                                          \
+  ::varia::PluginObject* varia_plugin_create_parts(const char* p, const char* c,            \
+                                                   const ::varia::Part* parts, int count,   \
+                                                   char* e, int n) noexcept {               \
+    return ::varia::sdk::create_with_parts<Class>(p, c, parts, count, e, n);                 \
+  }                                                                                          \
   }                                                                                          \
   BOOST_DLL_ALIAS(varia_plugin_info, varia_info)                                             \
-  BOOST_DLL_ALIAS(varia_plugin_create, varia_create)
+  BOOST_DLL_ALIAS(varia_plugin_create, varia_create)                                         \
+  BOOST_DLL_ALIAS(varia_plugin_create_parts, varia_create_parts)

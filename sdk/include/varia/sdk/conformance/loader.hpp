@@ -9,6 +9,7 @@
 #include <nlohmann/json.hpp>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "varia/abi/plugin_object.hpp"
 #include "varia/sdk/plugin.hpp"
@@ -37,15 +38,26 @@ class LoadedPlugin {
   const PluginInfo& info() const { return *info_; }
   nlohmann::json parameter_schema() const { return nlohmann::json::parse(info_->parameter_schema); }
 
-  // An object of the plugin's kind T made from `parameters` in `context`; throws
+  // An object of the plugin's kind T made from `parameters` in `context`, with the parts it takes
+  // (abi/plugin_object.hpp, Part; the caller keeps them alive as long as the object); throws
   // std::runtime_error with the plugin's message when it refuses them (without the factory's
   // kRefusedParameter mark of a refused value).
   template <class T>
   std::shared_ptr<T> create(const nlohmann::json& parameters,
-                            const nlohmann::json& context = {{"manifold", "Rn"}, {"point_size", 1}, {"dim", 1}}) const {
+                            const nlohmann::json& context = {{"manifold", "Rn"}, {"point_size", 1}, {"dim", 1}},
+                            const std::vector<Part>& parts = {}) const {
     char error[512] = "";
-    auto& factory = library_->get_alias<CreateFunction>("varia_create");
-    PluginObject* object = factory(parameters.dump().c_str(), context.dump().c_str(), error, sizeof error);
+    const std::string parameter_text = parameters.dump(), context_text = context.dump();
+    PluginObject* object = nullptr;
+    if (parts.empty()) {
+      auto& factory = library_->get_alias<CreateFunction>("varia_create");
+      object = factory(parameter_text.c_str(), context_text.c_str(), error, sizeof error);
+    } else {
+      if (!library_->has("varia_create_parts")) throw std::runtime_error(file_.string() + ": no varia_create_parts");
+      auto& factory = library_->get_alias<CreateWithPartsFunction>("varia_create_parts");
+      object = factory(parameter_text.c_str(), context_text.c_str(), parts.data(), static_cast<int>(parts.size()),
+                       error, sizeof error);
+    }
     if (object == nullptr) {
       const char* refused = refused_parameter(error);
       throw std::runtime_error(refused != nullptr ? refused : error);

@@ -21,12 +21,15 @@
 
 namespace varia::sdk::conformance {
 
-// The contexts a Lagrangian plugin may accept: Rn with dim 1 to 8, SO3 and SE3.
+// The contexts a Lagrangian plugin may accept: Rn with dim 1 to 8, SO3, SE3 and the products of
+// one and two SO3.
 inline std::vector<nlohmann::json> lagrangian_contexts() {
   std::vector<nlohmann::json> contexts;
   for (int n = 1; n <= 8; ++n) contexts.push_back({{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
   contexts.push_back({{"manifold", "SO3"}, {"point_size", 9}, {"dim", 3}});
   contexts.push_back({{"manifold", "SE3"}, {"point_size", 12}, {"dim", 6}});
+  contexts.push_back({{"manifold", "product(SO3)"}, {"point_size", 9}, {"dim", 3}});
+  contexts.push_back({{"manifold", "product(SO3,SO3)"}, {"point_size", 18}, {"dim", 6}});
   return contexts;
 }
 
@@ -69,7 +72,7 @@ inline void check_lagrangian_plugin(const LoadedPlugin& plugin, Failures& failur
                       "the schema's defaults are not the defaults of the constructor");
     for (const auto& failure : in_context.list()) failures.expect(false, context.dump(), ": ", failure);
   }
-  failures.expect(accepted > 0, "no context accepted with default parameters (Rn of dim 1 to 8, SO3)");
+  failures.expect(accepted > 0, "no context accepted with default parameters (Rn of dim 1 to 8, SO3, SE3, products of SO3)");
 }
 
 // The parameter objects an effect or force is made with: the schema's "examples" (draft-07), or
