@@ -98,7 +98,7 @@ void LieGroupGalerkinDiscreteLagrangian::size_workspace() {
   node_xi_.resize(n_);
   node_rate_.resize(n_);
   q_.resize(m_);
-  v_.resize(n_);
+  v_ = Eigen::VectorXd::Zero(n_);  // the inverse Legendre transform's first start
   grad_.resize(m_ + n_);
   hess_.resize(m_ + n_, m_ + n_);
   chain_ = Eigen::MatrixXd::Zero(m_ + n_, 3 * n_);

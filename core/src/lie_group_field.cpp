@@ -37,11 +37,27 @@ LieGroupField::LieGroupField(Manifold& manifold, LagrangianEvaluator& lagrangian
       y_jet_(m_ + n_),
       f_jet_(m_ + n_),
       momentum_(n_),
-      torque_(n_) {
-  if (!constant_mass_)
+      torque_(n_),
+      group_velocity_(m_),
+      group_velocity_jet_(m_) {
+  if (constant_mass_) return;
+  hessian_jet_variables_ = lagrangian.plugin().hessian_jet_variables();
+  if (hessian_jet_variables_ < 2)
     throw std::invalid_argument(
-        "one-step methods and the shooting construction on a Lie group need a Lagrangian with a constant inertia, "
-        "L = 1/2 xi^T J xi - V(g) (Lagrangian::constant_mass_matrix); this one declares none");
+        "one-step methods and the shooting construction on a Lie group need a Lagrangian with a constant inertia "
+        "(L = 1/2 xi^T J xi - V(g)) or its Hessian at jets of at least 2 variables (Lagrangian::hessian_jet: the "
+        "Euler-Poincare equations with an inertia that depends on the point); this one gives neither");
+  const int k = m_ + n_;
+  hessian_.resize(k, k);
+  inertia_inverse_.resize(n_, n_);
+  identity_ = Eigen::MatrixXd::Identity(n_, n_);
+  hessian_jet_.resize(static_cast<std::size_t>(k) * k);
+  residual_jet_.resize(n_);
+  correction_jet_.resize(n_);
+}
+
+int LieGroupField::jet_variables() const {
+  return constant_mass_ ? kMaxJetVariables : std::min(kMaxJetVariables, hessian_jet_variables_);
 }
 
 // dexp_{-xi} v = v - 1/2 [xi, v] + O(|xi|^2 |v|): the chart velocity's mixed second derivative
@@ -64,7 +80,8 @@ void LieGroupField::prepare(const double* y) {
   for (int k = 0; k < m_; ++k) point_jet_[k] = Jet2(y[k]);
   check(manifold_, manifold_.generators(point_jet_.data(), generators_jet_.data()), "manifold generators");
   for (int i = 0; i < m_ * n_; ++i) generators_[i] = generators_jet_[i].value;
-  lagrangian_.gradient(y, y + m_, gradient_.data());
+  if (constant_mass_) lagrangian_.gradient(y, y + m_, gradient_.data());
+  else lagrangian_.hessian(y, y + m_, gradient_.data(), hessian_.data());
 }
 
 void LieGroupField::prepare(const Jet2* y) {
@@ -75,28 +92,38 @@ void LieGroupField::prepare(const Jet2* y) {
   }
   check(manifold_, manifold_.generators(y, generators_jet_.data()), "manifold generators");
   lagrangian_.gradient_jet(y, y + m_, nullptr, gradient_jet_.data());
+  if (!constant_mass_) lagrangian_.hessian_jet(y, y + m_, hessian_jet_.data());
 }
 
-// g' = D xi;  J xi' = ad*_xi (J xi) + D^T dL/dg, with (ad*_xi mu)_b = sum_{a,c} mu_c xi_a [e_a, e_b]_c.
+// g' = D xi;  L_xixi xi' = ad*_xi mu + D^T dL/dg - L_xig g', with (ad*_xi mu)_b =
+// sum_{a,c} mu_c xi_a [e_a, e_b]_c and mu = dL/dxi (J xi for a constant inertia, where L_xig = 0).
 template <class T>
 void LieGroupField::rates(const T* y, const T* D, const T* gradient, T* velocity, T* rate) {
   T* mu;
   T* torque;
+  T* group_velocity;
   if constexpr (std::is_same_v<T, double>) {
     mu = momentum_.data();
     torque = torque_.data();
+    group_velocity = group_velocity_.data();
   } else {
     mu = momentum_jet_.data();
     torque = torque_jet_.data();
+    group_velocity = group_velocity_jet_.data();
   }
   const T* xi = y + m_;
-  if (velocity != nullptr)
+  if (velocity != nullptr) group_velocity = velocity;
+  if (velocity != nullptr || !constant_mass_)
     for (int k = 0; k < m_; ++k) {
       T sum(0.0);
       for (int a = 0; a < n_; ++a) sum += D[k * n_ + a] * xi[a];
-      velocity[k] = sum;
+      group_velocity[k] = sum;
     }
   for (int c = 0; c < n_; ++c) {
+    if (!constant_mass_) {
+      mu[c] = gradient[m_ + c];
+      continue;
+    }
     T sum(0.0);
     for (int b = 0; b < n_; ++b)
       if (mass_(c, b) != 0.0) sum += mass_(c, b) * xi[b];
@@ -110,9 +137,45 @@ void LieGroupField::rates(const T* y, const T* D, const T* gradient, T* velocity
         const double C = structure_[(c * n_ + a) * n_ + b];
         if (C != 0.0) sum += C * (mu[c] * xi[a]);
       }
+    if (!constant_mass_)
+      for (int k = 0; k < m_; ++k) {
+        if constexpr (std::is_same_v<T, double>)
+          sum -= mixed(b, k) * group_velocity[k];
+        else
+          sum -= mixed_jet(b, k) * group_velocity[k];
+      }
     torque[b] = sum;
   }
-  inverse_mass(torque, rate);
+  solve_inertia(torque, rate);
+}
+
+void LieGroupField::solve_inertia(const double* torque, double* rate) {
+  if (constant_mass_) return inverse_mass(torque, rate);
+  inertia_lu_.compute(hessian_.bottomRightCorner(n_, n_));
+  Eigen::Map<Eigen::VectorXd>(rate, n_) = inertia_lu_.solve(Eigen::Map<const Eigen::VectorXd>(torque, n_));
+}
+
+// At jets: rate = M0^{-1} torque, M0 the values of L_xixi, then two corrections
+// rate += M0^{-1} (torque - L_xixi rate): the error's value part is zero and each correction
+// multiplies it by I - M0^{-1} L_xixi, whose value part is zero, so that the first and then the
+// second derivatives become exact.
+void LieGroupField::solve_inertia(const Jet2* torque, Jet2* rate) {
+  if (constant_mass_) return inverse_mass(torque, rate);
+  const int k = m_ + n_;
+  const auto M = [&](int r, int c) -> const Jet2& { return hessian_jet_[(m_ + c) * k + m_ + r]; };
+  for (int r = 0; r < n_; ++r)
+    for (int c = 0; c < n_; ++c) inertia_inverse_(r, c) = M(r, c).value;
+  inertia_lu_.compute(inertia_inverse_);
+  inertia_inverse_.noalias() = inertia_lu_.solve(identity_);
+  multiply(inertia_inverse_, torque, rate);
+  for (int iteration = 0; iteration < 2; ++iteration) {
+    for (int r = 0; r < n_; ++r) {
+      Jet2& residual = residual_jet_[r] = torque[r];
+      for (int c = 0; c < n_; ++c) residual -= M(r, c) * rate[c];
+    }
+    multiply(inertia_inverse_, residual_jet_.data(), correction_jet_.data());
+    for (int r = 0; r < n_; ++r) rate[r] += correction_jet_[r];
+  }
 }
 
 Status LieGroupField::eval(const double* y, double* f) noexcept {
@@ -160,12 +223,12 @@ Status LieGroupField::move(const Jet2* y, const Jet2* xi, Jet2* moved) noexcept 
 }
 
 // Column c of df/dy is the derivative of f in y_c: the field at jets in a block of at most
-// kMaxJetVariables of the state's numbers at a time.
+// jet_variables() of the state's numbers at a time.
 Status LieGroupField::jacobian(const double* y, double* f, double* df) noexcept {
   return guard([&] {
-    const int N = m_ + n_;
-    for (int first = 0; first < N; first += kMaxJetVariables) {
-      const int count = std::min(kMaxJetVariables, N - first);
+    const int N = m_ + n_, block = jet_variables();
+    for (int first = 0; first < N; first += block) {
+      const int count = std::min(block, N - first);
       for (int i = 0; i < N; ++i)
         y_jet_[i] = i >= first && i < first + count ? Jet2::variable(y[i], count, i - first) : Jet2(y[i]);
       prepare(y_jet_.data());

@@ -38,7 +38,7 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       absolute_(n_),
       absolute_jet_(n_),
       force_jet_(n_),
-      v_(n_),
+      v_(Eigen::VectorXd::Zero(n_)),  // the inverse Legendre transform's first start
       gradient_(2 * n_),
       hessian_(2 * n_, 2 * n_),
       velocity_q_(n_, n_),
@@ -73,9 +73,6 @@ void EulerLagrangeField::inverse_mass(const double* w, double* x) const {
       inverse_mass_ * Eigen::Map<const Eigen::VectorXd>(w, n_);
 }
 
-namespace {
-
-// y = A x, A of doubles, x and y (distinct) of jets; A's zero entries are skipped.
 void multiply(const Eigen::MatrixXd& A, const Jet2* x, Jet2* y) {
   for (Eigen::Index r = 0; r < A.rows(); ++r) {
     y[r] = Jet2(0.0);
@@ -83,8 +80,6 @@ void multiply(const Eigen::MatrixXd& A, const Jet2* x, Jet2* y) {
       if (A(r, c) != 0.0) add_scaled(y[r], A(r, c), x[c]);
   }
 }
-
-}  // namespace
 
 void EulerLagrangeField::inverse_mass(const Jet2* w, Jet2* x) const { multiply(inverse_mass_, w, x); }
 

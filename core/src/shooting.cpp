@@ -151,7 +151,7 @@ void ShootingDiscreteLagrangian::size_workspace() {
   carry_p_ = Eigen::VectorXd::Zero(n_);
   end_q_.resize(m_);
   end_p_.resize(n_);
-  guess_.resize(n_);
+  guess_ = Eigen::VectorXd::Zero(n_);
   corrections_history_.resize(n_, kCorrections);
   origin_.resize(n_);
   Bq_.resize(n_, n_);

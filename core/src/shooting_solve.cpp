@@ -165,7 +165,8 @@ void ShootingDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
   const bool continues = continuing_ && end_q == start && end_p == momentum;
   if (form_ == ShootingForm::lagrangian && field_->constant_mass())
     guess.noalias() = Eigen::Map<const Square<N>>(field_->inverse_mass().data(), n, n) * momentum;
-  else if (form_ == ShootingForm::lagrangian) mechanical_->velocity_of(q0, p0, guess_.data());
+  else if (form_ == ShootingForm::lagrangian && mechanical_ != nullptr) mechanical_->velocity_of(q0, p0, guess_.data());
+  else if (form_ == ShootingForm::lagrangian) lagrangian_.inverse_legendre(q0, p0, guess_.data(), options_);  // a group
   else guess = momentum;
   warm_start<N>(continues && h == previous_h_);
   target_is_end_ = true;

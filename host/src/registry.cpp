@@ -82,8 +82,10 @@ std::vector<fs::path> so_files(const fs::path& directory) {
   return files;
 }
 
+// dlopen's own reason for refusing a file, asked again as open_library asked (Boost.DLL keeps only
+// a generic error code).
 std::string dlopen_error(const fs::path& file) {
-  void* handle = ::dlopen(file.c_str(), RTLD_LAZY | RTLD_LOCAL);
+  void* handle = ::dlopen(file.c_str(), RTLD_NOW | RTLD_LOCAL);
   if (handle != nullptr) {
     ::dlclose(handle);
     return "cannot be loaded";
@@ -139,14 +141,16 @@ struct Registry::Loaded {
 namespace {
 
 // Opens the file at its canonical path, the one whose directories distrust() checked: a link on
-// the path as given is not followed again.
+// the path as given is not followed again. Every symbol is resolved now (RTLD_NOW): a file that
+// needs one no library defines is refused here, with the linker's reason, rather than ending the
+// process at its first call.
 std::shared_ptr<boost::dll::shared_library> open_library(const fs::path& file) {
   auto library = std::make_shared<boost::dll::shared_library>();
   boost::dll::fs::error_code ec;
   std::error_code canonical_ec;
   const fs::path real = fs::canonical(file, canonical_ec);
   if (canonical_ec) throw Refused{"cannot be opened: " + canonical_ec.message()};
-  library->load(real, ec, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local);
+  library->load(real, ec, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local);
   if (ec) throw Refused{"not a loadable shared library: " + dlopen_error(file)};
   return library;
 }

@@ -43,7 +43,7 @@ struct PluginRecord {
   std::string kind, type, version;
   nlohmann::json parameter_schema, properties;
   DeclaredProperties declared;
-  std::vector<PartRole> part_roles;
+  std::vector<PartRole> part_roles{};
 };
 
 // An object made for a role of another's parameters, which the made object borrows.

@@ -62,6 +62,8 @@ TEST_CASE("plugins lists the good fault plugins and refuses each bad file with i
       {"fault_bad_properties.so", "its properties declare \"symplectic\": \"yes\", expected true or false"},
       // Issue 43, item 9: listing it overflowed the stack (exit 139).
       {"fault_deep_schema.so", "malformed parameter_schema in varia_info: /not/not/not/not/not/not/not/not"},
+      // Loaded lazily it was listed, and a run died at its first evaluation (exit 127).
+      {"fault_undefined_symbol.so", "not a loadable shared library: "},
   };
   const auto table = run_varia("plugins " + faults.flag());
   CAPTURE(table.out);
@@ -92,6 +94,7 @@ TEST_CASE("a scene needing a bad plugin exits 3 (4 for a non-finite value) namin
       {"fault-no-info", 3, "fault_no_metadata.so", "missing metadata (no varia_info)"},
       {"fault-bad-schema", 3, "fault_bad_schema.so", "unusable parameter_schema"},
       // Issue 43, item 10: the pattern was written through, and varia died of SIGSEGV (exit 139).
+      {"fault-undefined", 3, "fault_undefined_symbol.so", "undefined symbol: varia_fault_symbol_that_no_library_defines"},
       {"fault-bad-pattern", 3, "fault_bad_hessian_pattern.so",
        "sparse Hessian pattern names entry 3 at (row 268435456, column 268435456), outside its 2 x 2 Hessian"},
   };

@@ -1,9 +1,13 @@
 // Multibody systems on products of Lie groups (spec: "Constrained systems, S2 and products"):
 // rigid-body-chain with one body on product(SO3) moves as the heavy top on SO3 with the inertia
-// about the pivot, to round-off, under Lie group Galerkin and Crouch-Grossman shooting; the
-// three-body chain's scenes run through the host.
+// about the pivot, to round-off, under Lie group Galerkin, Crouch-Grossman shooting and the
+// Crouch-Grossman one-step method: the chain's inertia is read from its Hessian (it depends on the
+// attitudes in general), the top's is declared constant, so the Euler-Poincare field takes its
+// general form for one and J^{-1} for the other (core/lie_group_field.hpp). The three-body chain's
+// scenes run through the host.
 #include <doctest/doctest.h>
 
+#include <cmath>
 #include <nlohmann/json.hpp>
 
 #include "assemble.hpp"
@@ -54,7 +58,11 @@ json one_body(const json& method, bool as_chain) {
 
 TEST_CASE("rigid-body-chain with one body on product(SO3) moves as the heavy top on SO3, to round-off") {
   const json galerkin{{"construction", "galerkin"}, {"degree", 2}, {"quadrature", {{"type", "gauss-lobatto"}, {"points", 3}}}};
-  for (const json& method : {galerkin}) {
+  const json shooting{{"construction", "shooting"},
+                      {"one_step", {{"type", "crouch-grossman"}, {"order", 2}}},
+                      {"quadrature", {{"type", "trapezoid"}}}};
+  const json one_step{{"construction", "one-step"}, {"one_step", {{"type", "crouch-grossman"}, {"order", 3}}}};
+  for (const json& method : {galerkin, shooting, one_step}) {
     CAPTURE(method.dump());
     const Eigen::VectorXd chain = final_state(one_body(method, true)), top = final_state(one_body(method, false));
     CHECK((chain - top).cwiseAbs().maxCoeff() < 1e-12);
@@ -62,14 +70,33 @@ TEST_CASE("rigid-body-chain with one body on product(SO3) moves as the heavy top
 }
 
 TEST_CASE("the three-body rigid chain's scenes run on the product of three SO3 through the host") {
-  for (const std::string name : {"rigid-body-chain-3.json"}) {
+  for (const std::string name : {"rigid-body-chain-3.json", "rigid-body-chain-3-shooting-cg.json"}) {
     CAPTURE(name);
     json document = json::parse(test::read_file(test::kSourceDir / "scenes" / "multibody" / name));
     document.erase("t_end");
-    document["steps"] = 5;
+    document["steps"] = 2;  // a shooting step on this dense model of 36 numbers takes seconds
     const Eigen::VectorXd state = final_state(document);
     CHECK(state.size() == 27 + 9);
     CHECK(state.allFinite());
+  }
+}
+
+// About ten minutes on one core: 75 shooting steps of a few seconds each.
+TEST_SUITE("long") {
+  TEST_CASE("crouch-grossman shooting on the product of three SO3 (dimension 9) measures its order 2 against a "
+            "converged galerkin reference") {
+    test::TempDir dir;
+    const auto outcome = test::run_varia("cost " + test::quoted(test::kSourceDir / "scenes" / "multibody" /
+                                                                "rigid-body-chain-3-shooting-cg.json") +
+                                         " --h 0.08,0.04,0.02,0.01 --quiet --out " + test::quoted(dir.path()));
+    CAPTURE(outcome.err);
+    REQUIRE(outcome.code == 0);
+    const json method = json::parse(test::read_file(dir / "cost.json"))["methods"][0];
+    CAPTURE(method.dump());
+    CHECK(method["predicted_order"] == 2);
+    REQUIRE(method["fitted_slope"].is_number());
+    CHECK(method["points_fitted"].get<int>() >= 4);
+    CHECK(std::abs(method["fitted_slope"].get<double>() - 2.0) < 0.3);
   }
 }
 

@@ -40,6 +40,9 @@ enum class PhaseSpace { tangent, cotangent };
 void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian,
                           const char* construction);
 
+// y = A x, A of doubles, x and y (distinct) of jets; A's zero entries are skipped.
+void multiply(const Eigen::MatrixXd& A, const Jet2* x, Jet2* y);
+
 // Whether the Lagrangian declares a constant mass matrix (Lagrangian::constant_mass_matrix).
 bool declares_constant_mass(const Lagrangian& lagrangian);
 

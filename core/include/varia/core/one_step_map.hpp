@@ -21,7 +21,7 @@ namespace varia {
 class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
  public:
   // Throws std::invalid_argument unless the Lagrangian matches the manifold (a vector space or a
-  // Lie group) and has a constant mass matrix.
+  // Lie group) and the field can be formed (lie_group_field.hpp, mechanical_field.hpp).
   OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian, OneStepMethod& method,
                         SolverOptions options);
   int point_size() const override { return m_; }
@@ -39,6 +39,10 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
   std::unique_ptr<EulerLagrangeField> field_;
   OneStepMethod& method_;
   int m_, n_;  // point size, dimension
+  // The state is (q, xi) with the momenta converted by the Legendre transform where the field is in
+  // (q, v) without a constant mass matrix (on a Lie group), with these options.
+  bool tangent_;
+  SolverOptions options_;
   SolverStatistics statistics_;
   Eigen::VectorXd y0_, y1_;
 };

@@ -22,7 +22,7 @@ class LoadedPlugin {
   explicit LoadedPlugin(const std::filesystem::path& file) : file_(file) {
     library_ = std::make_shared<boost::dll::shared_library>();
     boost::dll::fs::error_code ec;
-    library_->load(file, ec, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local);
+    library_->load(file, ec, boost::dll::load_mode::rtld_now | boost::dll::load_mode::rtld_local);
     if (ec) throw std::runtime_error(file.string() + ": cannot be loaded: " + ec.message());
     if (!library_->has("varia_abi_version")) throw std::runtime_error(file.string() + ": no varia_abi_version");
     const int abi = library_->get<const int>("varia_abi_version");
