@@ -8,3 +8,4 @@ scripts/build.sh varia_demo
 mkdir -p out
 build/bin/varia run scenes/default.json --out out/default.csv --summary out/default.json \
   --plot out/default.svg
+echo "wrote out/default.csv (the trajectory), out/default.json (the run record) and out/default.svg (the plot)"

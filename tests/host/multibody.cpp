@@ -7,6 +7,7 @@
 // scenes run through the host.
 #include <doctest/doctest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <nlohmann/json.hpp>
 
@@ -81,8 +82,24 @@ TEST_CASE("the three-body rigid chain's scenes run on the product of three SO3 t
   }
 }
 
-// About ten minutes on one core: 75 shooting steps of a few seconds each.
 TEST_SUITE("long") {
+  // About 45 s.
+  TEST_CASE("verify holds what it predicts for the three-body rigid chain under lie group galerkin: orders 4 and "
+            "momentum and symplecticity") {
+    const auto outcome = test::run_varia(
+        "verify " + test::quoted(test::kSourceDir / "scenes" / "multibody" / "rigid-body-chain-3.json"));
+    CAPTURE(outcome.out);
+    CHECK(outcome.code == 0);
+    for (const char* property : {"ld_order", "global_order", "momentum_conserved", "symplectic", "g_invariant"}) {
+      CAPTURE(property);
+      const auto lines = test::lines_of(outcome.out);
+      CHECK(std::any_of(lines.begin(), lines.end(), [&](const std::string& line) {
+        return line.rfind(property, 0) == 0 && line.find(" yes") != std::string::npos;
+      }));
+    }
+  }
+
+  // About six minutes on one core: 75 shooting steps of a few seconds each.
   TEST_CASE("crouch-grossman shooting on the product of three SO3 (dimension 9) measures its order 2 against a "
             "converged galerkin reference") {
     test::TempDir dir;
