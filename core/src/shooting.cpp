@@ -317,9 +317,12 @@ void ShootingDiscreteLagrangian::propagate(const double* q0, const double* w0, d
     accumulate(static_cast<int>(i), h, S);
   }
   if (type_2()) {
-    generating_ = -S;  // H_d^+ = <p^n, q^n> - S
-    const Jet2* point = position();
-    for (int r = 0; r < n_; ++r) generating_ += state_[n_ + r] * point[r];
+    // H_d^+ = <p^n, q^n> - S, formed as G = <p^n, q^n - (q0 + eta)> - S from the state's offsets:
+    // its multiplier lambda is then q1 - q0, an increment that the step sums with Kahan's
+    // compensation, and D1 gains <p^n, q0 + eta>'s eta-derivative p^n (first_derivatives), the
+    // Newton Jacobian its w0-derivative B_w (residual).
+    generating_ = -S;
+    for (int r = 0; r < n_; ++r) generating_ += state_[n_ + r] * state_[r];
     std::copy_n(state_.begin() + n_, n_, boundary_.begin());
   } else {
     generating_ = S;

@@ -51,6 +51,8 @@ void ShootingDiscreteLagrangian::first_derivatives() {
   BwT_solver_.solve(Eigen::Map<const Vector<N>>(alpha_.data() + n, n), lambda);
   D1 = Eigen::Map<const Vector<N>>(alpha_.data(), n);
   D1.noalias() -= Bq.transpose() * lambda;
+  if (type_2())  // G = <p^n, offset^n> - S leaves out <p^n, q0 + eta>, whose eta-derivative is p^n
+    for (int r = 0; r < n; ++r) D1[r] += boundary_[r].value;
   if (offsets()) {
     Eigen::Map<Vector<N>>(momentum_change_.data(), n) = D1;
     D1 -= lambda;
@@ -78,6 +80,7 @@ void ShootingDiscreteLagrangian::residual(Target target, const double* data) {
       jacobian = phi_.template block<N, N>(0, n, n, n);
       jacobian.noalias() -= Bq.transpose() * lambda_jacobian;
       if (offsets()) jacobian -= lambda_jacobian;
+      if (type_2()) jacobian += Eigen::Map<const Square<N>>(Bw_.data(), n, n);  // d p^n / dw0
       break;
     case Target::boundary:
       for (int r = 0; r < n; ++r) F[r] = boundary_[r].value - given[r];
@@ -173,29 +176,29 @@ void ShootingDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
   solve<N>(q0, h, Target::momentum, p0);
   record_correction<N>(h);
   Eigen::Map<Vector<N>> p(p1, n);
-  if (offsets()) {
+  if (mechanical_ != nullptr) {  // a vector space: q1 - q0 is the offset B (type-2: lambda)
     Eigen::Map<Vector<N>> carry_q(carry_q_.data(), n), carry_p(carry_p_.data(), n),
         offset(offset_.data(), n), change(momentum_change_.data(), n);
     if (!continues) {
       carry_q.setZero();
       carry_p.setZero();
     }
-    for (int r = 0; r < n; ++r) offset[r] = boundary_[r].value;
-    change -= Eigen::Map<const Vector<N>>(residual_.data(), n);
+    if (type_2()) offset = Eigen::Map<const Vector<N>>(lambda_.data(), n);
+    else for (int r = 0; r < n; ++r) offset[r] = boundary_[r].value;
     end_q = start;
     compensated_add(end_q, offset, carry_q);
-    end_p = momentum;
-    compensated_add(end_p, change, carry_p);
+    if (type_2()) {  // p1 = p^n, as propagated
+      for (int r = 0; r < n; ++r) end_p[r] = boundary_[r].value;
+    } else {
+      change -= Eigen::Map<const Vector<N>>(residual_.data(), n);
+      end_p = momentum;
+      compensated_add(end_p, change, carry_p);
+    }
     Eigen::Map<Vector<N>>(q1, n) = end_q;
     p = end_p;
   } else {
-    if (type_2()) {
-      for (int r = 0; r < n; ++r) p[r] = boundary_[r].value;
-      Eigen::Map<Vector<N>>(q1, n) = Eigen::Map<const Vector<N>>(lambda_.data(), n);
-    } else {
-      for (int r = 0; r < m; ++r) q1[r] = state_[r].value;
-      p = Eigen::Map<const Vector<N>>(lambda_.data(), n);  // with forces p1 = D2 L_d + f_d^+
-    }
+    for (int r = 0; r < m; ++r) q1[r] = state_[r].value;
+    p = Eigen::Map<const Vector<N>>(lambda_.data(), n);  // with forces p1 = D2 L_d + f_d^+
     end_q = Eigen::Map<const Vector<N>>(q1, m);
     end_p = p;
   }
@@ -245,16 +248,15 @@ void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
   }
   target_is_end_ = false;
   std::copy_n(q1, m_, target_.begin());
-  // On a vector space B = q^n - q0 against q1 - q0 (type-2: lambda against q1); through the chart
-  // at q1, B = local(q1, q^n) against 0.
-  if (type_2()) {
-    solve<Eigen::Dynamic>(q0, h, Target::lambda, q1);
-  } else if (offsets()) {
+  // On a vector space B = q^n - q0 against q1 - q0 (type-2: lambda, an offset too, against it);
+  // through the chart at q1, B = local(q1, q^n) against 0.
+  if (mechanical_ != nullptr) {
     offset_ = Eigen::Map<const Eigen::VectorXd>(q1, n_) - Eigen::Map<const Eigen::VectorXd>(q0, n_);
-    solve<Eigen::Dynamic>(q0, h, Target::boundary, offset_.data());
+    solve<Eigen::Dynamic>(q0, h, type_2() ? Target::lambda : Target::boundary, offset_.data());
   } else {
     solve<Eigen::Dynamic>(q0, h, Target::boundary, zero_.data());
   }
+  // type-2: L_d = <p1, q1> - H_d^+ with H_d^+ = G + <p1, q0> (G as propagated), so <p1, q1 - q0> - G.
   double p1_q1 = 0.0;
   for (int r = 0; r < n_; ++r) p1_q1 += boundary_[r].value * lambda_[r];
   if (Ld != nullptr) *Ld = type_2() ? p1_q1 - generating_.value : generating_.value;
