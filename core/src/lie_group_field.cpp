@@ -39,7 +39,8 @@ LieGroupField::LieGroupField(Manifold& manifold, LagrangianEvaluator& lagrangian
       momentum_(n_),
       torque_(n_),
       group_velocity_(m_),
-      group_velocity_jet_(m_) {
+      group_velocity_jet_(m_),
+      inertia_solve_(0) {
   if (constant_mass_) return;
   hessian_jet_variables_ = lagrangian.plugin().hessian_jet_variables();
   if (hessian_jet_variables_ < 2)
@@ -49,11 +50,8 @@ LieGroupField::LieGroupField(Manifold& manifold, LagrangianEvaluator& lagrangian
         "Euler-Poincare equations with an inertia that depends on the point); this one gives neither");
   const int k = m_ + n_;
   hessian_.resize(k, k);
-  inertia_inverse_.resize(n_, n_);
-  identity_ = Eigen::MatrixXd::Identity(n_, n_);
   hessian_jet_.resize(static_cast<std::size_t>(k) * k);
-  residual_jet_.resize(n_);
-  correction_jet_.resize(n_);
+  inertia_solve_ = JetLinearSolve(n_);
 }
 
 int LieGroupField::jet_variables() const {
@@ -155,27 +153,11 @@ void LieGroupField::solve_inertia(const double* torque, double* rate) {
   Eigen::Map<Eigen::VectorXd>(rate, n_) = inertia_lu_.solve(Eigen::Map<const Eigen::VectorXd>(torque, n_));
 }
 
-// At jets: rate = M0^{-1} torque, M0 the values of L_xixi, then two corrections
-// rate += M0^{-1} (torque - L_xixi rate): the error's value part is zero and each correction
-// multiplies it by I - M0^{-1} L_xixi, whose value part is zero, so that the first and then the
-// second derivatives become exact.
+// At jets: L_xixi's block of L's Hessian at jets (JetLinearSolve).
 void LieGroupField::solve_inertia(const Jet2* torque, Jet2* rate) {
   if (constant_mass_) return inverse_mass(torque, rate);
   const int k = m_ + n_;
-  const auto M = [&](int r, int c) -> const Jet2& { return hessian_jet_[(m_ + c) * k + m_ + r]; };
-  for (int r = 0; r < n_; ++r)
-    for (int c = 0; c < n_; ++c) inertia_inverse_(r, c) = M(r, c).value;
-  inertia_lu_.compute(inertia_inverse_);
-  inertia_inverse_.noalias() = inertia_lu_.solve(identity_);
-  multiply(inertia_inverse_, torque, rate);
-  for (int iteration = 0; iteration < 2; ++iteration) {
-    for (int r = 0; r < n_; ++r) {
-      Jet2& residual = residual_jet_[r] = torque[r];
-      for (int c = 0; c < n_; ++c) residual -= M(r, c) * rate[c];
-    }
-    multiply(inertia_inverse_, residual_jet_.data(), correction_jet_.data());
-    for (int r = 0; r < n_; ++r) rate[r] += correction_jet_[r];
-  }
+  inertia_solve_.solve(hessian_jet_.data() + m_ * k + m_, k, torque, rate);
 }
 
 Status LieGroupField::eval(const double* y, double* f) noexcept {

@@ -52,6 +52,7 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       seed_(2 * n_),
       acceleration_jet_(n_),
       correction_jet_(n_),
+      acceleration_solve_(general_tangent() ? n_ : 0),
       hessian_jet_variables_(lagrangian.plugin().hessian_jet_variables()) {
   if (general_tangent() && hessian_jet_variables_ < 2)
     throw std::invalid_argument(
@@ -73,11 +74,35 @@ void EulerLagrangeField::inverse_mass(const double* w, double* x) const {
       inverse_mass_ * Eigen::Map<const Eigen::VectorXd>(w, n_);
 }
 
+namespace {
+
+// y = A x, A of doubles, x and y (distinct) of jets; A's zero entries are skipped.
 void multiply(const Eigen::MatrixXd& A, const Jet2* x, Jet2* y) {
   for (Eigen::Index r = 0; r < A.rows(); ++r) {
     y[r] = Jet2(0.0);
     for (Eigen::Index c = 0; c < A.cols(); ++c)
       if (A(r, c) != 0.0) add_scaled(y[r], A(r, c), x[c]);
+  }
+}
+
+}  // namespace
+
+JetLinearSolve::JetLinearSolve(int n)
+    : n_(n), inverse_(n, n), identity_(Eigen::MatrixXd::Identity(n, n)), lu_(n), residual_(n), correction_(n) {}
+
+void JetLinearSolve::solve(const Jet2* M, int stride, const Jet2* b, Jet2* x) {
+  for (int r = 0; r < n_; ++r)
+    for (int c = 0; c < n_; ++c) inverse_(r, c) = M[c * stride + r].value;
+  lu_.compute(inverse_);
+  inverse_.noalias() = lu_.solve(identity_);  // inverse() would allocate
+  multiply(inverse_, b, x);
+  for (int iteration = 0; iteration < 2; ++iteration) {
+    for (int r = 0; r < n_; ++r) {
+      Jet2& residual = residual_[r] = b[r];
+      for (int c = 0; c < n_; ++c) residual -= M[c * stride + r] * x[c];
+    }
+    multiply(inverse_, residual_.data(), correction_.data());
+    for (int r = 0; r < n_; ++r) x[r] += correction_[r];
   }
 }
 
@@ -258,10 +283,7 @@ void MechanicalField::acceleration(double* a) {
 }
 
 // a = M^{-1} (L_q + f - L_vq v) at jets (L_q + f in gradient_jet_), M = L_vv: L's Hessian at jets
-// gives M and L_vq; the linear solve at jets starts from M0^{-1} (L_q + f - L_vq v), M0 the mass
-// matrix's values, and takes two corrections a += M0^{-1} (rhs - M a): the error's value part is
-// zero and each correction multiplies it by I - M0^{-1} M, whose value part is zero, so that the
-// first and then the second derivatives become exact (as in velocity()).
+// gives M and L_vq, and the solve at jets starts from M's values (JetLinearSolve, as in velocity()).
 void MechanicalField::acceleration(const Jet2* q, const Jet2* v, Jet2* a) {
   lagrangian_.hessian_jet(q, v, hessian_jet_.data());
   const int k = 2 * n_;
@@ -269,19 +291,8 @@ void MechanicalField::acceleration(const Jet2* q, const Jet2* v, Jet2* a) {
   for (int r = 0; r < n_; ++r) {
     Jet2& rhs = legendre_residual_[r] = gradient_jet_[r];
     for (int c = 0; c < n_; ++c) rhs -= H(n_ + r, c) * v[c];
-    for (int c = 0; c < n_; ++c) velocity_q_(r, c) = H(n_ + r, n_ + c).value;  // M at the values
   }
-  mass_lu_.compute(velocity_q_);
-  velocity_q_.noalias() = mass_lu_.solve(identity_);  // M^{-1} at the values (inverse() would allocate)
-  multiply(velocity_q_, legendre_residual_.data(), a);
-  for (int iteration = 0; iteration < 2; ++iteration) {
-    for (int r = 0; r < n_; ++r) {
-      Jet2& residual = legendre_residual_[n_ + r] = legendre_residual_[r];
-      for (int c = 0; c < n_; ++c) residual -= H(n_ + r, n_ + c) * a[c];
-    }
-    multiply(velocity_q_, legendre_residual_.data() + n_, correction_jet_.data());
-    for (int r = 0; r < n_; ++r) a[r] += correction_jet_[r];
-  }
+  acceleration_solve_.solve(hessian_jet_.data() + n_ * k + n_, k, legendre_residual_.data(), a);
 }
 
 // The tangent form's Jacobian with a configuration-dependent mass matrix: the acceleration at jets

@@ -11,7 +11,7 @@
 // constant inertia J (L = 1/2 xi . J xi - V(g): the rigid body, the heavy top) mu = J xi, L_xig = 0
 // and the solve is J^{-1}; otherwise (a chain of bodies, whose inertia depends on their attitudes)
 // L's Hessian gives L_xixi and L_xig, at doubles and at jets (Lagrangian::hessian_jet), and the
-// solve at jets starts from L_xixi's values, corrected twice, as MechanicalField's acceleration.
+// solve at jets is MechanicalField's (JetLinearSolve, mechanical_field.hpp).
 // Runge-Kutta methods integrate the field in the embedding and leave the group; a Lie group
 // method sees TG as the group G x g acting on itself: xi(y) = (xi, xi') in g x g and
 // y . exp(eta) = (g exp(eta_g), xi + eta_xi) (Manifold::translate at jets, retract at doubles).
@@ -73,12 +73,13 @@ class LieGroupField final : public EulerLagrangeField {
       f_jet_;
   Eigen::VectorXd momentum_, torque_, group_velocity_;
   std::vector<Jet2> group_velocity_jet_;
-  // A configuration-dependent inertia: L's Hessian at doubles and at jets, L_xixi's LU and inverse
-  // at the values, the solve's residuals at jets.
+  // A configuration-dependent inertia: L's Hessian at doubles and at jets, L_xixi's LU at doubles
+  // and its solve at jets (sized in the constructor).
   int hessian_jet_variables_ = 0;
-  Eigen::MatrixXd hessian_, inertia_inverse_, identity_;
+  Eigen::MatrixXd hessian_;
   Eigen::PartialPivLU<Eigen::MatrixXd> inertia_lu_;
-  std::vector<Jet2> hessian_jet_, residual_jet_, correction_jet_;
+  std::vector<Jet2> hessian_jet_;
+  JetLinearSolve inertia_solve_;
 };
 
 }  // namespace varia

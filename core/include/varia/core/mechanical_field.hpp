@@ -40,8 +40,23 @@ enum class PhaseSpace { tangent, cotangent };
 void require_vector_space(const Manifold& manifold, const Lagrangian& lagrangian,
                           const char* construction);
 
-// y = A x, A of doubles, x and y (distinct) of jets; A's zero entries are skipped.
-void multiply(const Eigen::MatrixXd& A, const Jet2* x, Jet2* y);
+// x = M^{-1} b at jets, for a mass matrix M whose entries are jets (the velocity block of L's
+// Hessian at jets: MechanicalField's acceleration, LieGroupField's inertia). M's values are
+// inverted at doubles (M0), x = M0^{-1} b, then two corrections x += M0^{-1} (b - M x): the error's
+// value part is zero and each correction multiplies it by I - M0^{-1} M, whose value part is zero,
+// so that the first and then the second derivatives become exact. Workspace sized once.
+class JetLinearSolve {
+ public:
+  explicit JetLinearSolve(int n);
+  // M(r, c) is M[c * stride + r] (a block of a column-major matrix of jets); b and x distinct.
+  void solve(const Jet2* M, int stride, const Jet2* b, Jet2* x);
+
+ private:
+  int n_;
+  Eigen::MatrixXd inverse_, identity_;  // M0^{-1}
+  Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
+  std::vector<Jet2> residual_, correction_;
+};
 
 // Whether the Lagrangian declares a constant mass matrix (Lagrangian::constant_mass_matrix).
 bool declares_constant_mass(const Lagrangian& lagrangian);
@@ -171,12 +186,13 @@ class MechanicalField final : public EulerLagrangeField {
   std::vector<Jet2> force_jet_;
   // Workspace, sized once.
   Eigen::VectorXd v_, gradient_;
-  Eigen::MatrixXd hessian_, velocity_q_;  // v_q in cotangent_jacobian(), M^{-1} at the values in velocity() and acceleration()
+  Eigen::MatrixXd hessian_, velocity_q_;  // v_q in cotangent_jacobian(), M^{-1} at the values in velocity()
   Eigen::MatrixXd identity_;
   Eigen::VectorXd rhs_;
   Eigen::PartialPivLU<Eigen::MatrixXd> mass_lu_;  // L_vv at the last state (not constant_mass())
-  std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;  // the last also acceleration()'s right side, residual
+  std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;  // the last also acceleration()'s right side
   std::vector<Jet2> hessian_jet_, seed_, acceleration_jet_, correction_jet_;  // correction_jet_: M^{-1} times a residual
+  JetLinearSolve acceleration_solve_;  // sized for the general tangent form only
   int hessian_jet_variables_;  // the Lagrangian's (Lagrangian::hessian_jet_variables)
   SolverOptions legendre_options_;
 };
