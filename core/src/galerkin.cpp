@@ -1,5 +1,7 @@
 #include "varia/core/galerkin.hpp"
 
+#include "galerkin_equations.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
@@ -77,7 +79,8 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
                                                        Quadrature& quadrature,
                                                        std::vector<double> control_times,
                                                        SolverOptions options,
-                                                       std::vector<Force*> forces)
+                                                       std::vector<Force*> forces,
+                                                       HolonomicConstraints* constraints)
     : lagrangian_(lagrangian),
       forces_(std::move(forces), manifold.dim(), manifold.dim()),
       basis_(control_times, quadrature),
@@ -128,6 +131,14 @@ GalerkinDiscreteLagrangian::GalerkinDiscreteLagrangian(Manifold& manifold, Lagra
   for (std::size_t e = 0; e < forces_.rows().size(); ++e)
     entries_.push_back(Entry{forces_.rows()[e], forces_.cols()[e] % n_, false, forces_.cols()[e] >= n_});
   action_ = action_function(n_);
+  if (constraints != nullptr && constraints->size() > 0) {  // the exact Newton with multipliers only
+    constraints_ = constraints;
+    multipliers_ = Eigen::MatrixXd::Zero(constraints->size(), s_);
+    position_update_.resize(s_ * n_);
+    momentum_.resize(n_);
+    step_ = step_function(n_, 0, false);
+    return;
+  }
   explicit_advance_ = explicit_form(quadrature);
   if (explicit_advance_ != nullptr) return;
   node_iteration_ = simplified_applies();
@@ -257,54 +268,6 @@ void GalerkinDiscreteLagrangian::take_steps(double* q, double* p, double t0, dou
       q, p, t0, h, steps, q1, p1);
 }
 
-// The equations dS/dq^nu (+ f_d^nu when forced) = 0, nu in [first_equation, first_equation +
-// blocks), in the control points [first_unknown, first_unknown + blocks), with p0 (if not null)
-// added to the equation nu = 0 (IDEL: p0 + D1 L_d + f_d^0 = 0), as a system for NewtonSolver
-// (solve/newton.hpp), with the exact Jacobian.
-struct GalerkinDiscreteLagrangian::Equations {
-  GalerkinDiscreteLagrangian& g;
-  double h;
-  int first_unknown, first_equation, blocks;
-  const double* p0;
-  bool forced;
-
-  int size() const { return blocks * g.n_; }
-  // F's round-off yardstick: the largest of its terms p0 and dS/dq^nu.
-  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
-    g.action(h, Order::hessian, forced);
-    F = g.gradient_.segment(first_equation * g.n_, size());
-    double yardstick = g.gradient_.lpNorm<Eigen::Infinity>();
-    if (p0 != nullptr) {
-      const Eigen::Map<const Eigen::VectorXd> momentum(p0, g.n_);
-      F.head(g.n_) += momentum;
-      yardstick = std::max(yardstick, momentum.lpNorm<Eigen::Infinity>());
-    }
-    return yardstick;
-  }
-  void factorize() {
-    if (g.lagrangian_.sparse()) return g.factorize_sparse();
-    g.dense_.jacobian = g.hessian_.block(first_equation * g.n_, first_unknown * g.n_, size(), size());
-    g.dense_.factorize();
-  }
-  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) {
-    if (g.lagrangian_.sparse()) update = g.sparse_.lu.solve(F);
-    else g.dense_.solve(F, update);
-  }
-  // x's round-off yardstick: the control points' size, q^0 + offsets.
-  double apply(const Eigen::VectorXd& update) {
-    g.points_.middleCols(first_unknown, blocks).reshaped() -= update;
-    return g.origin_.lpNorm<Eigen::Infinity>() + g.points_.lpNorm<Eigen::Infinity>();
-  }
-  // The gradient at the updated points; for the step's equations (p0 given), impulse_ less their
-  // residuals there (see take_step).
-  void finish(const Eigen::VectorXd& update) {
-    g.gradient_after_update(h, first_unknown, update, forced);
-    if (p0 == nullptr) return;
-    g.impulse_ -= g.gradient_.head(g.n_) + Eigen::Map<const Eigen::VectorXd>(p0, g.n_);
-    for (int nu = 1; nu < g.s_; ++nu) g.impulse_ -= g.gradient_.segment(nu * g.n_, g.n_);
-  }
-};
-
 // Eigen's SparseLU: the symbolic analysis (COLAMD ordering) once per structure, the numerical
 // factorization when the solver asks for it.
 void GalerkinDiscreteLagrangian::factorize_sparse() {
@@ -323,6 +286,7 @@ void GalerkinDiscreteLagrangian::factorize_sparse() {
 void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_equation,
                                         int blocks, const double* p0, bool forced) {
   if (lagrangian_.sparse()) prepare_sparse(first_unknown, first_equation, blocks);
+  if (constraints_ != nullptr) return constrained_newton(h, first_unknown, first_equation, blocks, p0, forced);
   const int size = blocks * n_;
   if (!lagrangian_.sparse() && dense_.jacobian.rows() != size) dense_ = DenseLinearization(size);
   Equations equations{*this, h, first_unknown, first_equation, blocks, p0, forced};
@@ -334,7 +298,7 @@ void GalerkinDiscreteLagrangian::newton(double h, int first_unknown, int first_e
 // round-off here, so the neglected O(|update|^2) term is far below it and no evaluation is made.
 // Sparse: the Jacobian holds only the equations' rows, so the gradient is evaluated again.
 void GalerkinDiscreteLagrangian::gradient_after_update(double h, int first_unknown,
-                                                       const Eigen::VectorXd& update, bool forced) {
+                                                       Eigen::Ref<const Eigen::VectorXd> update, bool forced) {
   if (lagrangian_.sparse()) {
     action(h, Order::gradient, forced);
     return;

@@ -243,6 +243,7 @@ void GalerkinDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
   if (!(node_iteration_ && solve_at_nodes<N, R>(p0, h, continues))) {
     warm_start(q0, p0, h, continues);
     newton(h, 1, 0, s_, p0, !forces_.empty());
+    if (constraints_ != nullptr) project_momentum(p0);
   }
   Eigen::Map<Vector> end(previous_end_.data(), n), momentum(end_p_.data(), n);
   end = Eigen::Map<const Vector>(q0, n);

@@ -1,6 +1,9 @@
 #include "varia/core/verification.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Core>
+#include <Eigen/LU>
+#include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
 #include <random>
@@ -392,51 +395,86 @@ class CanonicalChart {
   Eigen::VectorXd velocity_gradient_;  // d velocity / d (xi, xi_dot), component-major
 };
 
-// Central-difference Jacobian of the one-step map in canonical chart coordinates at
-// (xi, pi) = (0, p0), with difference step steps[j] in coordinate j.
-Eigen::MatrixXd jacobian(CanonicalChart& chart, const double* p0, int n, double h, const Eigen::VectorXd& steps) {
-  Eigen::MatrixXd M(2 * n, 2 * n);
+// The one-step map's derivative in canonical chart coordinates at (xi, pi) = (0, p0) along each
+// column d_j of `directions` (a difference step), by central differences of factor d_j:
+// column j is M d_j.
+Eigen::MatrixXd directional(CanonicalChart& chart, const double* p0, int n, double h, const Eigen::MatrixXd& directions,
+                            double factor) {
+  Eigen::MatrixXd images(2 * n, directions.cols());
   Eigen::VectorXd z = Eigen::VectorXd::Zero(2 * n), plus(2 * n), minus(2 * n);
   for (int i = 0; i < n; ++i) z[n + i] = p0[i];
-  for (int j = 0; j < 2 * n; ++j) {
-    for (double sign : {1.0, -1.0}) {
-      Eigen::VectorXd w = z;
-      w[j] += sign * steps[j];
-      chart.step(w, h, sign > 0 ? plus : minus);
-    }
-    M.col(j) = (plus - minus) / (2 * steps[j]);
+  for (Eigen::Index j = 0; j < directions.cols(); ++j) {
+    chart.step(z + factor * directions.col(j), h, plus);
+    chart.step(z - factor * directions.col(j), h, minus);
+    images.col(j) = (plus - minus) / (2 * factor);
   }
-  return M;
+  return images;
 }
 
-// The defect of S M S^-1, S = diag(1/a, a): the defect in the rescaled coordinates (S is
-// symplectic, so it is zero exactly when M is symplectic).
-double defect(const Eigen::MatrixXd& M, const Eigen::VectorXd& a) {
-  const int n = static_cast<int>(M.rows()) / 2;
+// The defect of the symplectic form on the directions D, in the rescaled coordinates S = diag(1/a, a)
+// (S is symplectic) with each direction of unit length there: max |(S M D N)^T J (S M D N) -
+// (S D N)^T J (S D N)|, N = diag(1 / |S d_j|). With D the coordinate directions it is
+// ||(S M S^-1)^T J (S M S^-1) - J||max, zero exactly when M is symplectic; with D a basis of the
+// tangent space of a submanifold, zero exactly when M preserves the form restricted to it.
+double defect(const Eigen::MatrixXd& images, const Eigen::MatrixXd& directions, const Eigen::VectorXd& a) {
+  const int n = static_cast<int>(images.rows()) / 2;
   Eigen::VectorXd s(2 * n);
   s << a.cwiseInverse(), a;
-  const Eigen::MatrixXd scaled = s.asDiagonal() * M * s.cwiseInverse().asDiagonal();
+  Eigen::MatrixXd in = s.asDiagonal() * directions, out = s.asDiagonal() * images;
+  for (Eigen::Index j = 0; j < in.cols(); ++j) {
+    const double length = in.col(j).norm();
+    in.col(j) /= length;
+    out.col(j) /= length;
+  }
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2 * n, 2 * n);
   J.topRightCorner(n, n).setIdentity();
   J.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
-  return (scaled.transpose() * J * scaled - J).cwiseAbs().maxCoeff();
+  return (out.transpose() * J * out - in.transpose() * J * in).cwiseAbs().maxCoeff();
 }
 
 }  // namespace
 
 SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& manifold,
                                          const double* q0, const double* p0, double h,
-                                         const Eigen::VectorXd& steps) {
+                                         const Eigen::VectorXd& steps, const Eigen::MatrixXd& tangent) {
   // Richardson: (4 M(d/2) - M(d)) / 3 cancels the O(d^2) term of central differences.
   const int n = manifold.dim();
   const Eigen::VectorXd a = (steps.head(n).array() / steps.tail(n).array()).sqrt();
+  const Eigen::MatrixXd directions = tangent.size() > 0 ? tangent : Eigen::MatrixXd(steps.asDiagonal());
   CanonicalChart chart(map, manifold, q0);
   auto richardson = [&](double factor) {
     return Eigen::MatrixXd(
-        (4.0 * jacobian(chart, p0, n, h, factor / 2 * steps) - jacobian(chart, p0, n, h, factor * steps)) / 3.0);
+        (4.0 * directional(chart, p0, n, h, directions, factor / 2) - directional(chart, p0, n, h, directions, factor)) /
+        3.0);
   };
-  const double coarse = defect(richardson(1.0), a), fine = defect(richardson(0.5), a);
+  const double coarse = defect(richardson(1.0), directions, a), fine = defect(richardson(0.5), directions, a);
   return {fine, std::abs(fine - coarse) + 1e-13};
+}
+
+Eigen::MatrixXd constrained_tangent_basis(HolonomicConstraints& constraints, const Eigen::MatrixXd& mass,
+                                          const double* q, const double* p, double position_step, double momentum_step) {
+  const int n = constraints.dim(), m = constraints.size();
+  constraints.evaluate_jacobian(q);
+  const Eigen::MatrixXd G = constraints.jacobian();
+  const Eigen::LLT<Eigen::MatrixXd> M(mass);
+  const Eigen::VectorXd v = M.solve(Eigen::Map<const Eigen::VectorXd>(p, n));
+  Eigen::MatrixXd K(m, n);  // d(G(q) v)/dq at fixed v: row i is (H_i v)^T, H_i the Hessian of g_i
+  Eigen::VectorXd unit = Eigen::VectorXd::Zero(m);
+  for (int i = 0; i < m; ++i) {
+    unit.setZero();
+    unit[i] = 1.0;
+    constraints.evaluate_hessian(q, unit.data());
+    K.row(i) = (constraints.hessian() * v).transpose();
+  }
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(G.transpose());
+  const Eigen::MatrixXd Z = Eigen::MatrixXd(qr.householderQ()).rightCols(n - m);  // an orthonormal basis of ker G
+  const Eigen::MatrixXd MinvGt = M.solve(G.transpose());
+  const Eigen::MatrixXd lift = -G.transpose() * (G * MinvGt).partialPivLu().solve(K * Z);  // dp keeping G M^-1 p = 0
+  Eigen::MatrixXd basis = Eigen::MatrixXd::Zero(2 * n, 2 * (n - m));
+  basis.topLeftCorner(n, n - m) = position_step * Z;
+  basis.bottomLeftCorner(n, n - m) = position_step * lift;
+  basis.bottomRightCorner(n, n - m) = momentum_step * (mass * Z);
+  return basis;
 }
 
 EnergyDrift energy_drift(const std::vector<double>& energy_error) {

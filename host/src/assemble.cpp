@@ -2,7 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
+#include <vector>
 
 #include "constructions/parts.hpp"
 #include "registry.hpp"
@@ -21,6 +23,63 @@ void create_forces(const Scene& scene, Registry& registry, Assembly& a) {
                                  "Lagrange-d'Alembert principle), not '{}'",
                                  constructions_taking_forces(), scene.construction->name()));
   for (const auto& spec : scene.forces) a.forces.push_back(make_part<Force>(registry, spec, scene, *a.manifold));
+}
+
+// A constant mass matrix, declared: constant_mass_matrix for a dense Lagrangian, has_constant_mass_matrix
+// for a sparse one.
+bool has_constant_mass_matrix(Lagrangian& lagrangian) {
+  const int *rows = nullptr, *cols = nullptr;
+  if (lagrangian.hessian_pattern(&rows, &cols) >= 0) return lagrangian.has_constant_mass_matrix();
+  std::vector<double> mass(static_cast<std::size_t>(lagrangian.velocity_size()) * lagrangian.velocity_size());
+  return lagrangian.constant_mass_matrix(mass.data());
+}
+
+// Spec "Constrained systems": the constraints, bound to the system (its coordinates, and its particles'
+// space where the Lagrangian is a particle system), as one g. A construction that does not take them
+// on this manifold, or a Lagrangian without a constant mass matrix (the hidden constraint's
+// projection, docs/constraints.md), is refused at /system/constraints.
+void create_constraints(const Scene& scene, Registry& registry, Assembly& a) {
+  if (scene.constraints.empty()) return;
+  if (!scene.construction->takes_constraints(a.manifold->structure()))
+    throw InputError(fmt::format("/system/constraints: constraints are taken by the galerkin construction on vector "
+                                 "spaces (docs/constraints.md), not by '{}' on the {} manifold",
+                                 scene.construction->name(), scene.manifold.type));
+  if (!has_constant_mass_matrix(*a.lagrangian))
+    throw InputError(fmt::format("/system/constraints: constraints need a Lagrangian with a constant mass matrix (the "
+                                 "momenta's projection onto the constraint), and the {} Lagrangian declares none",
+                                 scene.lagrangian.type));
+  std::vector<Constraint*> bound;
+  const int n = a.manifold->dim();
+  for (const auto& spec : scene.constraints) {
+    auto constraint = make_part<Constraint>(registry, spec, scene, *a.manifold);
+    if (const Status refused = constraint->bind(n, a.lagrangian->space_dim()); refused != nullptr)
+      throw InputError(fmt::format("{}: {}", spec.pointer, refused));
+    bound.push_back(constraint.get());
+    a.constraints.push_back(std::move(constraint));
+  }
+  a.holonomic = std::make_unique<HolonomicConstraints>(bound, n);
+}
+
+// Spec: initial.q satisfies every constraint within kInitialConstraintTolerance (the rod's g is
+// relative to its length), and the initial velocity (v, or M^{-1} p) is tangent to them within
+// the same tolerance times the largest speed (1 at rest).
+constexpr double kInitialConstraintTolerance = 1e-10;
+void check_initial_constraints(const Scene& scene, Assembly& a) {
+  if (!a.holonomic) return;
+  if (const double g = a.holonomic->residual(a.q0.data()); !(g <= kInitialConstraintTolerance))
+    throw InputError(fmt::format("/initial/q: expected a point on the constraints (max |g_i(q)| <= {:g}); found "
+                                 "max |g_i(q)| = {:.3g}",
+                                 kInitialConstraintTolerance, g));
+  Eigen::VectorXd v = a.v0;
+  if (v.size() != a.p0.size()) {
+    v = Eigen::VectorXd::Zero(a.p0.size());
+    LagrangianEvaluator(*a.lagrangian).inverse_legendre(a.q0.data(), a.p0.data(), v.data(), scene.solver);
+  }
+  const double tolerance = kInitialConstraintTolerance * std::max(1.0, v.lpNorm<Eigen::Infinity>());
+  if (const double Gv = a.holonomic->velocity_residual(a.q0.data(), v.data()); !(Gv <= tolerance))
+    throw InputError(fmt::format("/initial/{}: expected a velocity tangent to the constraints (max |(G(q) v)_i| <= "
+                                 "{:.3g}); found {:.3g}",
+                                 scene.v ? "v" : "p", tolerance, Gv));
 }
 
 // The constructions serve vector spaces and Lie groups (a product of Lie groups is one); a
@@ -66,6 +125,9 @@ void check_observables(const Scene& scene, Lagrangian& lagrangian, const Manifol
   if (scene.observe.momentum && lagrangian.momentum_size() <= 0)
     throw InputError(fmt::format("/observe: expected no \"momentum\": the {} Lagrangian declares no symmetry",
                                  scene.lagrangian.type));
+  if ((scene.observe.constraint || scene.observe.constraint_velocity) && scene.constraints.empty())
+    throw InputError(fmt::format("/observe: expected no \"{}\": the system has no constraints",
+                                 scene.observe.constraint ? "constraint" : "constraint_velocity"));
   if (scene.observe.orthogonality && !manifold.has_constraint())
     throw InputError(fmt::format(
         "/observe: expected no \"orthogonality\": it is defined on SO3 and SE3 only, and the manifold is {}",
@@ -155,8 +217,10 @@ Assembly assemble(const Scene& scene, Registry& registry) {
   check_dense_size(scene, *a.lagrangian);
   check_observables(scene, *a.lagrangian, *a.manifold);
   create_forces(scene, registry, a);
+  create_constraints(scene, registry, a);
   scene.construction->build(scene, registry, a);
   initial_state(scene, a);
+  check_initial_constraints(scene, a);
   return a;
 }
 

@@ -9,11 +9,13 @@
 
 #include "scene.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
+#include "varia/abi/constraint.hpp"
 #include "varia/abi/force.hpp"
 #include "varia/abi/lagrangian.hpp"
 #include "varia/abi/manifold.hpp"
 #include "varia/abi/one_step.hpp"
 #include "varia/abi/quadrature.hpp"
+#include "varia/core/constraints.hpp"
 #include "varia/core/verification.hpp"
 
 namespace varia::host {
@@ -28,6 +30,8 @@ struct Assembly {
   std::shared_ptr<Quadrature> quadrature;  // when the construction uses one
   std::shared_ptr<OneStepMethod> one_step;  // when the construction uses one
   std::vector<std::shared_ptr<Force>> forces;  // system.forces
+  std::vector<std::shared_ptr<Constraint>> constraints;  // system.constraints, bound to the system
+  std::unique_ptr<HolonomicConstraints> holonomic;  // them as one g (null without constraints)
   std::unique_ptr<DiscreteHamiltonianMap> map;
   DiscreteLagrangian* discrete_lagrangian = nullptr;  // when the construction has one (in `map`)
   bool one_step_symplectic = false;  // what the one-step plugin declares (its "symplectic" property)

@@ -17,6 +17,7 @@
 #include "crash.hpp"
 #include "errors.hpp"
 #include "interrupt.hpp"
+#include "memory.hpp"
 #include "output.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/abi/plugin_object.hpp"
@@ -254,6 +255,7 @@ int main_cli(int argc, char** argv) {
   open_standard_descriptors();
   install_interrupt_handlers();
   install_crash_handlers();
+  keep_freed_memory();
   return run_command_line(argc, argv, [](const std::string&) { return true; });
 }
 

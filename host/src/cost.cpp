@@ -79,7 +79,7 @@ Row measure(Method& m, double h, long steps) {
   Assembly& a = m.assembly;
   const long evaluations = evaluation_count(a.map->evaluations());
   const long iterations = a.map->solver_statistics().iterations;
-  Observer observer(Observe{true, false, false}, *a.manifold, *a.lagrangian, a.v0, m.scene.solver);
+  Observer observer(Observe::energy_only(), *a.manifold, *a.lagrangian, a.v0, m.scene.solver);
   const TimedRun f = run_timed(a, h, steps, &observer);
   Row row{h, steps, distance(f, *m.truth), observer.energy_error(), f.seconds,
           a.map->solver_statistics().iterations - iterations, evaluation_count(a.map->evaluations()) - evaluations};
@@ -169,7 +169,7 @@ void load_method(const std::string& file, Registry& registry, std::deque<Method>
   try {
     m.name = method_name(file);
     m.scene = load_scene(file, registry);
-    m.scene.observe = Observe{true, false, false};  // the energy error is always measured
+    m.scene.observe = Observe::energy_only();  // the energy error is always measured
     m.assembly = assemble(m.scene, registry);
     // The order the theorems give for the parts that assemble() recorded (verification.hpp).
     m.predicted_order = m.scene.construction->predict(m.scene, m.assembly).global_order.value_or(0);

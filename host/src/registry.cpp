@@ -43,8 +43,8 @@ struct Refused {
   std::string reason;
 };
 
-constexpr Kind kKinds[] = {Kind::manifold, Kind::quadrature, Kind::lagrangian,
-                           Kind::one_step, Kind::effect,     Kind::force};
+constexpr Kind kKinds[] = {Kind::manifold, Kind::quadrature, Kind::lagrangian, Kind::one_step,
+                           Kind::effect,   Kind::force,      Kind::constraint};
 
 std::string kind_name(Kind kind) {
   switch (kind) {
@@ -54,6 +54,7 @@ std::string kind_name(Kind kind) {
     case Kind::one_step: return "one_step";
     case Kind::effect: return "effect";
     case Kind::force: return "force";
+    case Kind::constraint: return "constraint";
   }
   return "unknown";
 }

@@ -8,6 +8,8 @@
 #include <cmath>
 #include <cstdio>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "interrupt.hpp"
 #include "observer.hpp"
@@ -88,6 +90,8 @@ json run_record(const Scene& scene, const Assembly& a, const Observer& observer,
   if (scene.observe.energy) record["energy_error_max"] = observer.energy_error();
   if (scene.observe.momentum) record["momentum_error_max"] = observer.momentum_error();
   if (scene.observe.orthogonality) record["orthogonality_error_max"] = observer.orthogonality_error();
+  if (scene.observe.constraint) record["constraint_error_max"] = observer.constraint_error();
+  if (scene.observe.constraint_velocity) record["constraint_velocity_error_max"] = observer.constraint_velocity_error();
   record["plugins_loaded"] = registry.loaded();
   return record;
 }
@@ -103,6 +107,9 @@ void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, c
   if (scene.observe.energy) fmt::print(to, "energy error max  {:.3e}\n", observer.energy_error());
   if (scene.observe.momentum) fmt::print(to, "momentum error    {:.3e}\n", observer.momentum_error());
   if (scene.observe.orthogonality) fmt::print(to, "orthogonality     {:.3e}\n", observer.orthogonality_error());
+  if (scene.observe.constraint) fmt::print(to, "constraint max    {:.3e}\n", observer.constraint_error());
+  if (scene.observe.constraint_velocity)
+    fmt::print(to, "constraint velocity max {:.3e}\n", observer.constraint_velocity_error());
   fmt::print(to, "Newton iterations mean {:.2f}, max {}\n", statistics.mean(), statistics.max_iterations);
   fmt::print(to, "wall time         {:.4f} s\n", outcome.wall_seconds);
 }
@@ -225,7 +232,7 @@ class Stepper {
   Stepper(const Scene& scene, Assembly& a, const RunOptions& options)
       : scene_(scene),
         a_(a),
-        observer_(scene.observe, *a.manifold, *a.lagrangian, a.v0, scene.solver),
+        observer_(scene.observe, *a.manifold, *a.lagrangian, a.v0, scene.solver, a.holonomic.get()),
         trajectory_(*a.map, a.q0, a.p0, a.t0, scene.step) {
     if (options.out && options.out->extension() == ".h5")
       h5_ = std::make_unique<Hdf5Writer>(*options.out, scene.text);
@@ -327,7 +334,8 @@ class Stepper {
   Observer observer_;
   Trajectory trajectory_;
   RunOutcome outcome_;
-  const bool observing_ = scene_.observe.energy || scene_.observe.momentum || scene_.observe.orthogonality;
+  const bool observing_ = scene_.observe.energy || scene_.observe.momentum || scene_.observe.orthogonality ||
+                          scene_.observe.constraint || scene_.observe.constraint_velocity;
   std::unique_ptr<CsvWriter> csv_;
   std::unique_ptr<Hdf5Writer> h5_;
   std::unique_ptr<PlotRecorder> plot_;
@@ -339,6 +347,29 @@ class Stepper {
 json residual_json(double residual) {
   if (std::isfinite(residual)) return residual;
   return std::isnan(residual) ? "nan" : residual > 0 ? "inf" : "-inf";
+}
+
+// Spec (docs/interface.md, departure_warning): an observed quantity the system conserves (the
+// energy without forces; the momentum of a declared symmetry without forces or constraints) that
+// departed from its start by more than the scene's fraction of its scale is said, so that a run
+// whose step or coordinates fail (a chart's singularity, as the pole of spherical angles) does not
+// pass silently.
+std::vector<std::string> departure_warnings(const Scene& scene, const Assembly& a, const Observer& observer) {
+  std::vector<std::string> warnings;
+  const double fraction = scene.departure_warning;
+  if (fraction <= 0.0 || !a.forces.empty()) return warnings;
+  const auto say = [&](const char* what, double departure, double scale, const char* scale_name) {
+    if (!(departure > fraction * scale) || scale <= 0.0) return;
+    warnings.push_back(fmt::format(
+        "the {} departed from its start by {:.3g}, {:.3g} of its scale {} = {:.3g} (departure_warning {:g}): the step "
+        "does not resolve the motion, or the coordinates fail along it (a chart's singularity, as the pole of "
+        "spherical angles); a smaller step tells which",
+        what, departure, departure / scale, scale_name, scale, fraction));
+  };
+  if (scene.observe.energy) say("energy", observer.energy_error(), observer.energy_scale(), "|<p0, v0>| + |L(q0, v0)|");
+  if (scene.observe.momentum && !a.holonomic)
+    say("momentum", observer.momentum_error(), observer.momentum_scale(), "max(1, |J0|)");
+  return warnings;
 }
 
 }  // namespace
@@ -371,8 +402,11 @@ RunOutcome run_scene(const Scene& scene, Assembly& assembly, const Registry& reg
                     {"t", failure->t},
                     {"residual", residual_json(failure->residual)},
                     {"message", failure->message}}}});
-  else
-    write_record(json::object());
+  else {
+    const std::vector<std::string> warnings = departure_warnings(scene, assembly, stepper.observer());
+    for (const auto& warning : warnings) fmt::print(stderr, "varia: warning: {}\n", warning);
+    write_record(warnings.empty() ? json::object() : json{{"warnings", warnings}});
+  }
   if (options.plot) stepper.plot()->write(*options.plot);
   if (failure)
     throw NumericalFailure(fmt::format("step {} (from t = {:.10g}) failed: {}; residual {:.3e}", failure->step,

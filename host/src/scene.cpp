@@ -89,6 +89,8 @@ void read_observe(const json& document, Scene& scene) {
     if (name == "energy") scene.observe.energy = true;
     if (name == "momentum") scene.observe.momentum = true;
     if (name == "orthogonality") scene.observe.orthogonality = true;
+    if (name == "constraint") scene.observe.constraint = true;
+    if (name == "constraint_velocity") scene.observe.constraint_velocity = true;
   }
 }
 
@@ -104,6 +106,7 @@ void check_size(const std::vector<double>& values, int expected, const std::stri
 std::vector<PluginSpec*> Scene::plugins() {
   std::vector<PluginSpec*> all{&manifold, &lagrangian};
   for (auto& force : forces) all.push_back(&force);
+  for (auto& constraint : constraints) all.push_back(&constraint);
   if (quadrature) all.push_back(&*quadrature);
   if (one_step) all.push_back(&*one_step);
   return all;
@@ -119,6 +122,9 @@ Scene parse_scene(const json& document) {
   const json forces = system.value("forces", json::array());
   for (std::size_t i = 0; i < forces.size(); ++i)
     scene.forces.push_back(plugin_spec(forces[i], fmt::format("/system/forces/{}", i), "force"));
+  const json constraints = system.value("constraints", json::array());
+  for (std::size_t i = 0; i < constraints.size(); ++i)
+    scene.constraints.push_back(plugin_spec(constraints[i], fmt::format("/system/constraints/{}", i), "constraint"));
   read_method(document["method"], scene);
   scene.step = document["step"].get<double>();
   const json& initial = document["initial"];
@@ -127,6 +133,7 @@ Scene parse_scene(const json& document) {
   check_time_resolution(scene.t0, scene.step, scene.steps);
   read_observe(document, scene);
   if (document.contains("output")) scene.output_every = document["output"].value("every", 1);
+  scene.departure_warning = document.value("departure_warning", scene.departure_warning);
   scene.q = initial["q"].get<std::vector<double>>();
   if (initial.contains("p")) scene.p = initial["p"].get<std::vector<double>>();
   if (initial.contains("v")) scene.v = initial["v"].get<std::vector<double>>();

@@ -34,7 +34,12 @@ struct PluginSpec {
 std::string manifold_name(const PluginSpec& manifold);
 
 struct Observe {
-  bool energy = false, momentum = false, orthogonality = false;
+  bool energy = false, momentum = false, orthogonality = false, constraint = false, constraint_velocity = false;
+  static Observe energy_only() {
+    Observe o;
+    o.energy = true;
+    return o;
+  }
 };
 
 struct Scene {
@@ -43,6 +48,7 @@ struct Scene {
   std::shared_ptr<const MethodOptions> method_options;  // its own keys of "method", read by it
   PluginSpec manifold, lagrangian;
   std::vector<PluginSpec> forces;
+  std::vector<PluginSpec> constraints;  // system.constraints
   std::optional<PluginSpec> quadrature, one_step;  // the parts a construction names in "method"
   SolverOptions solver;
   double t0 = 0.0;  // initial.t: the start time
@@ -50,6 +56,9 @@ struct Scene {
   long steps = 0;  // given, or round((t_end - t0) / step)
   Observe observe;
   int output_every = 1;
+  // departure_warning: the fraction of its scale by which an observed conserved quantity may depart
+  // from its start before the run warns (0: never).
+  double departure_warning = 0.01;
   std::vector<double> q;
   std::optional<std::vector<double>> p, v;  // exactly one is set
 

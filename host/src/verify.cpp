@@ -185,25 +185,31 @@ PropertyCheck g_invariant(VerifiedScene& x) {
 
 // ---- symplectic ------------------------------------------------------------------------------------
 
-// The mass of each degree of freedom at (q, v): the diagonal of d^2 L / dv^2 (1 where that is not a
-// positive number).
-std::vector<double> masses(VerifiedScene& x, const double* q, const double* v) {
-  std::vector<double> mass(x.n, 1.0), gradient(x.m + x.n);
-  auto keep = [&](int j, double value) {
-    if (std::isfinite(value) && value > 0.0) mass[j] = value;
-  };
+// d^2 L / dv^2 at (q, v), dense (a test of a property).
+Eigen::MatrixXd velocity_hessian(VerifiedScene& x, const double* q, const double* v) {
+  std::vector<double> gradient(x.m + x.n);
+  Eigen::MatrixXd block = Eigen::MatrixXd::Zero(x.n, x.n);
   if (x.lagrangian.sparse()) {
     std::vector<double> values(x.lagrangian.pattern_size());
     x.lagrangian.sparse_hessian(q, v, gradient.data(), values.data());
     for (int k = 0; k < x.lagrangian.pattern_size(); ++k)
-      if (const int row = x.lagrangian.pattern_rows()[k]; row == x.lagrangian.pattern_cols()[k] && row >= x.m)
-        keep(row - x.m, values[k]);
-    return mass;
+      if (const int row = x.lagrangian.pattern_rows()[k], col = x.lagrangian.pattern_cols()[k]; row >= x.m && col >= x.m)
+        block(row - x.m, col - x.m) += values[k];
+    return block;
   }
   const int size = x.m + x.n;
-  std::vector<double> hessian(static_cast<std::size_t>(size) * size);
+  Eigen::MatrixXd hessian(size, size);
   x.lagrangian.hessian(q, v, gradient.data(), hessian.data());
-  for (int j = 0; j < x.n; ++j) keep(j, hessian[static_cast<std::size_t>(x.m + j) * size + x.m + j]);
+  return hessian.bottomRightCorner(x.n, x.n);
+}
+
+// The mass of each degree of freedom at (q, v): the diagonal of d^2 L / dv^2 (1 where that is not a
+// positive number).
+std::vector<double> masses(VerifiedScene& x, const double* q, const double* v) {
+  const Eigen::VectorXd diagonal = velocity_hessian(x, q, v).diagonal();
+  std::vector<double> mass(x.n, 1.0);
+  for (int j = 0; j < x.n; ++j)
+    if (std::isfinite(diagonal[j]) && diagonal[j] > 0.0) mass[j] = diagonal[j];
   return mass;
 }
 
@@ -223,18 +229,40 @@ Eigen::VectorXd difference_steps(VerifiedScene& x) {
   return steps;
 }
 
+// With constraints, the directions of the constrained phase space {g = 0, G M^-1 p = 0} at the start
+// (constrained_tangent_basis), with the difference steps' speed scale and their length scale or a
+// thousandth of the constraints' own, 1 / max |G| (a rod's length), the smaller; else none (every
+// coordinate direction).
+Eigen::MatrixXd tangent_directions(VerifiedScene& x, const Eigen::VectorXd& steps) {
+  if (!x.a.holonomic) return {};
+  const auto v0 = initial_velocity(x);
+  const Eigen::MatrixXd M = velocity_hessian(x, x.a.q0.data(), v0.data());
+  const double speed = Eigen::Map<const Eigen::VectorXd>(v0.data(), x.n).lpNorm<Eigen::Infinity>();
+  x.a.holonomic->evaluate_jacobian(x.a.q0.data());
+  const double G = x.a.holonomic->jacobian().coeffs().cwiseAbs().maxCoeff();
+  const double length = std::min(steps.head(x.n).maxCoeff(), G > 0.0 ? 1e-3 / G : INFINITY);
+  return constrained_tangent_basis(*x.a.holonomic, M, x.a.q0.data(), x.a.p0.data(), length,
+                                   1e-3 * (speed > 0.0 ? speed : 1.0));
+}
+
 PropertyCheck symplectic(VerifiedScene& x) {
   const Eigen::VectorXd steps = difference_steps(x);
+  const Eigen::MatrixXd tangent = tangent_directions(x, steps);
   const auto d = defect_values("symplectic", steps_of(x, {1, 0, -1}), kNoiseSpread * kEpsilon, [&](double h, double& noise) {
-    const auto defect = symplecticity_defect(*x.a.map, *x.a.manifold, x.a.q0.data(), x.a.p0.data(), h, steps);
+    const auto defect =
+        symplecticity_defect(*x.a.map, *x.a.manifold, x.a.q0.data(), x.a.p0.data(), h, steps, tangent);
     noise = std::max(noise, 10 * defect.noise);
     return defect.defect;
   });
   return defect_check("symplectic", prediction(x.predictions.symplectic), d,
-                      "||M^T J M - J||max in canonical chart coordinates, each in its own scale (positions in the "
-                      "state's length, momenta in mass times its speed), M by Richardson-extrapolated central "
-                      "differences of a thousandth of those scales (noise: 10 times their change with the "
-                      "difference step)");
+                      std::string(x.a.holonomic ? "on the constraint's cotangent bundle {g = 0, G M^-1 p = 0}: "
+                                                  "max |omega(M u, M w) - omega(u, w)| over a basis of its tangent "
+                                                  "space, "
+                                                  : "||M^T J M - J||max ") +
+                          "in canonical chart coordinates, each in its own scale (positions in the "
+                          "state's length, momenta in mass times its speed), M by Richardson-extrapolated central "
+                          "differences of a thousandth of those scales (noise: 10 times their change with the "
+                          "difference step)");
 }
 
 // ---- momentum_conserved, energy_bounded: long runs at h and h/2 to the same time ---------------------

@@ -14,7 +14,8 @@ namespace {
 
 using nlohmann::json;
 
-// Spec "Outputs": t, q0.., p0.., then energy; momentum0..; orthogonality as asked.
+// Spec "Outputs": t, q0.., p0.., then energy; momentum0..; orthogonality; constraint;
+// constraint_velocity as asked.
 std::vector<std::string> expected_header(const json& scene, int momentum_columns) {
   std::vector<std::string> columns{"t"};
   const auto& initial = scene["initial"];
@@ -25,7 +26,8 @@ std::vector<std::string> expected_header(const json& scene, int momentum_columns
   const auto asked = [&](const char* name) { return std::find(observe.begin(), observe.end(), name) != observe.end(); };
   if (asked("energy")) columns.emplace_back("energy");
   for (int i = 0; i < momentum_columns; ++i) columns.push_back("momentum" + std::to_string(i));
-  if (asked("orthogonality")) columns.emplace_back("orthogonality");
+  for (const char* name : {"orthogonality", "constraint", "constraint_velocity"})
+    if (asked(name)) columns.emplace_back(name);
   return columns;
 }
 
@@ -55,6 +57,10 @@ void check_run_record(const json& scene, const json& record, long rows) {
   const auto observe = scene.value("observe", json::array());
   const bool energy = std::find(observe.begin(), observe.end(), "energy") != observe.end();
   CHECK(record.contains("energy_error_max") == energy);
+  for (const char* name : {"constraint", "constraint_velocity"}) {
+    const bool asked = std::find(observe.begin(), observe.end(), name) != observe.end();
+    CHECK(record.contains(std::string(name) + "_error_max") == asked);
+  }
   CHECK_FALSE(record.contains("failure"));
   const auto& loaded = record["plugins_loaded"];
   CHECK(std::find(loaded.begin(), loaded.end(), scene["system"]["lagrangian"]["type"]) != loaded.end());
@@ -268,6 +274,32 @@ TEST_CASE("output.every writes every k-th step, step 0 and the last step") {
   std::vector<std::string> times;
   for (std::size_t i = 1; i < lines.size(); ++i) times.push_back(split(lines[i])[0]);
   CHECK(times == std::vector<std::string>{"0", "0.4", "0.8", "1"});
+}
+
+// A step too large for the motion: the pendulum of default.json at h = 0.5 departs from its energy by
+// several percent, and says so; with departure_warning 0.5 (or 0) it does not.
+TEST_CASE("a run whose energy departs from its start by more than departure_warning warns on stderr and in the record") {
+  TempDir dir;
+  json scene = json::parse(read_file(kSourceDir / "scenes" / "pendulum-galerkin-s1.json"));
+  scene["step"] = 0.8;
+  write_file(dir / "coarse.json", scene.dump());
+  const auto outcome = run_varia("run '" + (dir / "coarse.json").string() + "' --quiet --summary '" +
+                                 (dir / "r.json").string() + "'");
+  CAPTURE(outcome.err);
+  CHECK(outcome.code == 0);
+  CHECK(contains(outcome.err, "varia: warning: the energy departed from its start"));
+  const json record = json::parse(read_file(dir / "r.json"));
+  REQUIRE(record.contains("warnings"));
+  CHECK(record["warnings"].size() == 1);
+  for (const double fraction : {0.5, 0.0}) {
+    scene["departure_warning"] = fraction;
+    write_file(dir / "tolerant.json", scene.dump());
+    const auto quiet = run_varia("run '" + (dir / "tolerant.json").string() + "' --quiet");
+    CHECK(quiet.code == 0);
+    CHECK(quiet.err.empty());
+  }
+  const auto fine = run_varia("run scenes/pendulum-galerkin-s1.json --quiet");
+  CHECK(fine.err.empty());
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "varia/abi/manifold.hpp"
 #include "varia/core/verification.hpp"
 
 namespace varia::host {
@@ -38,6 +39,9 @@ class Construction {
   virtual std::shared_ptr<const MethodOptions> read(const nlohmann::json& method) const = 0;
   // Whether it takes the system's forces (the discrete Lagrange-d'Alembert principle).
   virtual bool takes_forces() const { return false; }
+  // Whether it takes holonomic constraints (system.constraints) on this manifold structure, by
+  // multipliers in its equations (docs/constraints.md).
+  virtual bool takes_constraints(ManifoldStructure /*structure*/) const { return false; }
   // Creates the construction's own plugin objects and the map into `assembly`, whose manifold,
   // Lagrangian and forces are made; InputError (with the pointer) for a composition it cannot
   // serve.

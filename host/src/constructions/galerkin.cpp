@@ -4,6 +4,7 @@
 // "Natural charts"). Core: varia/core/galerkin.hpp (vector spaces), galerkin_chart.hpp (groups).
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "../json_schema.hpp"
@@ -24,6 +25,7 @@ struct GalerkinOptions : MethodOptions {
   // polynomial space of the equispaced times the contract names, solved in a basis that keeps
   // round-off at high degree.
   std::vector<double> control_times;
+  bool control_times_given = false;
   bool reduced = false;
 };
 
@@ -52,10 +54,32 @@ Determination determination(const Quadrature& rule, int s) {
   return d;
 }
 
+// With constraints the control points carry them (core/galerkin.hpp): unless the scene gives control
+// times, they are the rule's nodes where the rule has s + 1 nodes from 0 to 1 (a Lobatto rule), so
+// that the equations are Jay's Lobatto IIIA-IIIB ones; otherwise the options' times.
+std::vector<double> control_times(const GalerkinOptions& o, const Quadrature& rule, const Assembly& a) {
+  const std::vector<double> nodes(rule.nodes(), rule.nodes() + rule.size());
+  const bool fits = static_cast<int>(nodes.size()) == o.degree + 1 && nodes.front() == 0.0 && nodes.back() == 1.0;
+  return a.holonomic && !o.control_times_given && fits ? nodes : o.control_times;
+}
+
+// Jay's theorem (SIAM J. Numer. Anal. 33, 1996: the s-stage Lobatto IIIA-IIIB pair for constrained
+// mechanical systems, constraints and multipliers at every stage, has order 2s - 2 in q and p) for
+// degree s: control times at the nodes of a rule of s + 1 nodes from 0 to 1 exact to degree 2s - 1
+// (the Lobatto rule of s + 1 points, the only one), order 2s.
+bool lobatto_constrained(const GalerkinOptions& o, const Quadrature& rule, const Assembly& a) {
+  const std::vector<double> times = control_times(o, rule, a);
+  return rule.size() == o.degree + 1 && rule.degree() >= 2 * o.degree - 1 &&
+         std::equal(times.begin(), times.end(), rule.nodes());
+}
+
 class Galerkin final : public Construction {
  public:
   const char* name() const override { return "galerkin"; }
   bool takes_forces() const override { return true; }
+  bool takes_constraints(ManifoldStructure structure) const override {
+    return structure == ManifoldStructure::vector_space;
+  }
 
   json schema() const override {
     return method_schema(
@@ -84,6 +108,7 @@ class Galerkin final : public Construction {
     auto options = std::make_shared<GalerkinOptions>();
     options->degree = method["degree"].get<int>();
     options->reduced = method.value("reduced", false);
+    options->control_times_given = method.contains("control_times");
     options->control_times = method.contains("control_times")
                                  ? method["control_times"].get<std::vector<double>>()
                                  : chebyshev_lobatto_control_times(options->degree);
@@ -106,7 +131,8 @@ class Galerkin final : public Construction {
       throw InputError("/method/reduced: the reduced (Euler-Poincare) form is for Lie groups; " + scene.manifold.type +
                        " is a vector space");
     auto map = std::make_unique<GalerkinDiscreteLagrangian>(*a.manifold, *a.lagrangian, *a.quadrature,
-                                                            o.control_times, scene.solver, forces_of(a));
+                                                            control_times(o, *a.quadrature, a), scene.solver,
+                                                            forces_of(a), a.holonomic.get());
     a.discrete_lagrangian = map.get();
     a.map = std::move(map);
   }
@@ -126,8 +152,35 @@ class Galerkin final : public Construction {
                "; self-adjoint for a symmetric rule on a vector space (L_d depends on the polynomial space, not on "
                "the control times; the natural chart at q0 of a Lie group is not symmetric); G-invariant L_d from an "
                "equivariant interpolant";
+    if (a.holonomic) predict_constrained(scene, a, p);
     apply_shared_theorems(a, true, p);
     return p;
+  }
+
+  // With constraints at the control points (docs/constraints.md): the constrained discrete
+  // Euler-Lagrange equations are symplectic on the constraint's cotangent bundle (Marsden & West
+  // 2001, sec. 3.5), and so keep the energy bounded; the order is Jay's where the equations are the
+  // Lobatto IIIA-IIIB pair's, otherwise no theorem gives one; L_d's own order is not predicted.
+  static void predict_constrained(const Scene& scene, const Assembly& a, Predictions& p) {
+    const auto& o = options(scene);
+    p.ld_order.reset();
+    p.global_order.reset();
+    const std::vector<double> t = control_times(o, *a.quadrature, a);
+    bool symmetric_times = true;
+    for (std::size_t k = 0; k < t.size(); ++k) symmetric_times = symmetric_times && std::abs(t[k] + t[t.size() - 1 - k] - 1.0) <= 1e-14;
+    if (p.self_adjoint) p.self_adjoint = *p.self_adjoint && symmetric_times;
+    if (lobatto_constrained(o, *a.quadrature, a)) {
+      p.global_order = 2 * o.degree;
+      p.reason = fmt::format("constrained Galerkin with control points at the {} Lobatto nodes: Jay's Lobatto IIIA-IIIB "
+                             "equations, order 2s = {} (Jay 1996); symplectic on the constraint's cotangent bundle "
+                             "(Marsden & West 2001, sec. 3.5)",
+                             o.degree + 1, 2 * o.degree);
+    } else {
+      p.reason = "constrained Galerkin with control points not at the nodes of a Lobatto rule of s + 1 points: no "
+                 "theorem gives its order (not predicted); symplectic on the constraint's cotangent bundle (Marsden & "
+                 "West 2001, sec. 3.5)";
+    }
+    p.reason += "; self-adjoint for a symmetric rule with symmetric control times; L_d's order not predicted";
   }
 
   std::string describe(const Scene& scene) const override {
@@ -174,11 +227,15 @@ const Construction& galerkin_construction() {
 
 Scene galerkin_reference(const Scene& scene, int degree, int points) {
   Scene reference = scene;
-  const json quadrature{{"type", "gauss-legendre"}, {"points", points}};
+  // With constraints: Lobatto's rule of degree + 1 points, the control points at its nodes (Jay's
+  // Lobatto IIIA-IIIB equations, order 2 degree), as no theorem gives Gauss's order there.
+  const std::string rule = scene.constraints.empty() ? "gauss-legendre" : "gauss-lobatto";
+  if (!scene.constraints.empty()) points = degree + 1;
+  const json quadrature{{"type", rule}, {"points", points}};
   reference.construction = &galerkin_construction();
   reference.method_options =
       reference.construction->read({{"construction", "galerkin"}, {"degree", degree}, {"quadrature", quadrature}});
-  reference.quadrature = PluginSpec{"/method/quadrature", "quadrature", "gauss-legendre", {{"points", points}}};
+  reference.quadrature = PluginSpec{"/method/quadrature", "quadrature", rule, {{"points", points}}};
   reference.one_step.reset();
   return reference;
 }

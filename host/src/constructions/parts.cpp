@@ -18,6 +18,11 @@ void apply_shared_theorems(const Assembly& a, std::optional<bool> ld_invariant, 
     p.g_invariant = ld_invariant;
     if (ld_invariant.value_or(false)) p.momentum_conserved = true;
   }
+  if (a.holonomic && (p.g_invariant || p.momentum_conserved)) {
+    p.g_invariant.reset();
+    p.momentum_conserved.reset();
+    p.reason += "; with constraints a symmetry of L need not be one of g: G-invariance and momentum not predicted";
+  }
   if (!a.forces.empty()) {
     p.symplectic.reset();
     p.energy_bounded.reset();

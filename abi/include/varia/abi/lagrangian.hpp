@@ -94,6 +94,11 @@ class Lagrangian : public PluginObject {
                                 double* /*q*/, double* /*v*/) noexcept {
     return "this Lagrangian has no exact solution";
   }
+
+  // Where q holds the positions of particles (a particle system: particle i at
+  // q[i * space_dim + k]), the dimension of their space, else 0; what a constraint on particles
+  // binds to (Constraint::bind). ABI 16.
+  virtual int space_dim() const noexcept { return 0; }
 };
 
 }  // namespace varia

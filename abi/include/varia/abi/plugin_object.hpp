@@ -27,7 +27,8 @@ namespace varia {
 // is a new id or version of kernels.hpp, not a new ABI version. Exported functions a plugin may
 // add without changing the layout of any interface (varia_create_parts, for parts) are not new
 // versions either: a plugin that lacks one keeps loading, and is refused only where it is needed.
-inline constexpr int kAbiVersion = 15;
+// 16: the constraint kind (constraint.hpp, Kind::constraint); Lagrangian::space_dim.
+inline constexpr int kAbiVersion = 16;
 
 using Status = const char*;
 
@@ -42,7 +43,7 @@ inline const char* refused_parameter(const char* error) {
 }
 
 // The plugin kinds. New kinds are appended; existing ones keep their interfaces.
-enum class Kind { manifold, quadrature, lagrangian, one_step, effect, force };
+enum class Kind { manifold, quadrature, lagrangian, one_step, effect, force, constraint };
 
 class PluginObject;
 

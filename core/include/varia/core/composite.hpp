@@ -32,6 +32,7 @@ class CompositeLagrangian : public Lagrangian {
   int hessian_pattern(const int** rows, const int** cols) const noexcept final;
   bool constant_mass_matrix(double* mass) const noexcept final;
   bool has_constant_mass_matrix() const noexcept final { return true; }  // diag(m_i), each repeated space_dim times
+  int space_dim() const noexcept final { return d_; }
   // L and its gradient at jets, from the effects' (Effect::gradient_jet): the shooting
   // construction's field. Available when every effect evaluates at jets.
   bool evaluates_at_jets() const noexcept final;

@@ -27,6 +27,14 @@
 // 0 and 1 only and a constant mass matrix (constant_mass_matrix for a dense Lagrangian,
 // has_constant_mass_matrix for a sparse one) takes no Newton iteration: its equations are
 // explicit (Stormer-Verlet for the trapezoid rule).
+// Holonomic constraints g(q) = 0 (constraints.hpp) enter by multipliers, as blocks of the one
+// Newton system (docs/constraints.md): the control points q^1..q^s lie on the constraint and each
+// equation nu < s gains -G(q^nu)^T lambda_nu,
+//   p0 delta_nu0 + dS/dq^nu + f_d^nu - G(q^nu)^T lambda_nu = 0 (nu < s),   g(q^mu) = 0 (mu = 1..s),
+// the constrained discrete Euler-Lagrange equations of L_d(q0, q1) = ext S over internal control
+// points on the constraint; p1 = D2 L_d + f_d^s - G(q1)^T mu then lies on the constraint's cotangent
+// space, G(q1) M^{-1} p1 = 0. With s + 1 Lobatto points and control points at them, these are
+// Jay's Lobatto IIIA-IIIB equations for constrained mechanics (order 2s).
 #pragma once
 
 #include <Eigen/Core>
@@ -35,8 +43,10 @@
 #include <Eigen/SparseCholesky>
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
+#include <memory>
 #include <vector>
 
+#include "varia/core/constraints.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/abi/force.hpp"
 #include "varia/abi/manifold.hpp"
@@ -76,7 +86,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // through the same interface once the manifold provides it.
   GalerkinDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian, Quadrature& quadrature,
                              std::vector<double> control_times, SolverOptions options,
-                             std::vector<Force*> forces = {});
+                             std::vector<Force*> forces = {}, HolonomicConstraints* constraints = nullptr);
   int degree() const { return static_cast<int>(basis_.control_times.size()) - 1; }
 
   // L_d, D1 L_d, D2 L_d with the internal control points extremized (any output may be null);
@@ -131,6 +141,14 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void newton(double h, int first_unknown, int first_equation, int blocks, const double* p0,
               bool forced);
   struct Equations;  // those equations as a NewtonSolver system
+  // With constraints: those equations bordered by the multipliers' blocks (see the top), in the
+  // control points and the multipliers lambda_nu of the equations (galerkin_constrained.cpp); the
+  // bordered Jacobian's pattern for these equations and unknowns; the projection of p1.
+  struct ConstrainedEquations;
+  void constrained_newton(double h, int first_unknown, int first_equation, int blocks, const double* p0, bool forced);
+  void prepare_bordered(int first_unknown, int first_equation, int blocks);
+  void project_momentum(const double* p0);
+  std::vector<Eigen::Triplet<double>> mass_entries(const double* q);
   // Simplified Newton for a constant mass matrix, in the nodes' coordinates (see the top):
   // whether it applies (and its linear maps, formed once), the extrapolation of the last steps'
   // forces to the next step's nodes, the fixed point as a NewtonSolver system, its solve (true when
@@ -159,7 +177,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void factorize_sparse();
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
-  void gradient_after_update(double h, int first_unknown, const Eigen::VectorXd& update, bool forced);
+  void gradient_after_update(double h, int first_unknown, Eigen::Ref<const Eigen::VectorXd> update, bool forced);
   // The control points' initial guess for Newton's method with the exact Jacobian; `continues`:
   // the step continues the last one (same h, from its q1).
   void warm_start(const double* q0, const double* p0, double h, bool continues);
@@ -266,6 +284,22 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::MatrixXd kick_;
   bool plugin_runs_steps_ = false;
   Eigen::VectorXd verlet_start_;
+  // Constraints (null without): the multipliers lambda_nu of the equations as columns (m x s, kept
+  // across steps as the next step's start), g at the unknown points (m x s), the bordered Newton
+  // Jacobian and where its entries go (base: the unconstrained Jacobian's entries in its own
+  // order; per equation block, the Hessian of lambda . g at its point and -G^T; per unknown block, G),
+  // and the projection of p1 (made at the first step, from M).
+  HolonomicConstraints* constraints_ = nullptr;
+  Eigen::MatrixXd multipliers_;
+  Eigen::VectorXd position_update_, momentum_;
+  struct Bordered {
+    int first_unknown = -1, first_equation = -1, blocks = 0;
+    FixedPatternMatrix matrix;
+    std::vector<int> base;
+    std::vector<std::vector<int>> hessian, transposed, jacobian;
+  };
+  Bordered bordered_;
+  std::unique_ptr<CotangentProjection> projection_;
 };
 
 }  // namespace varia

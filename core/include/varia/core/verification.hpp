@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "varia/core/constraints.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/abi/manifold.hpp"
 #include "varia/core/mechanics.hpp"
@@ -135,13 +136,24 @@ void run(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q, const Eigen::Vec
 // defect in coordinates measured in their own scales (dimensionless, and a light body's entries
 // neither swamp nor vanish beside a heavy one's; unit steps leave the coordinates as they are).
 // `noise` is the change of the defect between two difference steps: the floor below which the
-// defect means nothing.
+// defect means nothing. With `tangent` (2n x k, its columns difference steps spanning the tangent
+// space of a submanifold of T*Q at (q0, p0)), the defect is that of the form restricted to it:
+// max |omega(M u_i, M u_j) - omega(u_i, u_j)| over its columns, each of unit length in the rescaled
+// coordinates (constrained_tangent_basis: the constraint's cotangent bundle).
 struct SymplecticityDefect {
   double defect = 0.0, noise = 0.0;
 };
 SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& manifold,
                                          const double* q0, const double* p0, double h,
-                                         const Eigen::VectorXd& steps);
+                                         const Eigen::VectorXd& steps, const Eigen::MatrixXd& tangent = {});
+
+// A basis of the tangent space at (q, p) of the constrained phase space {g(q) = 0, G(q) M^{-1} p =
+// 0} (M the constant mass matrix, dense here: a test of a property): positions along an
+// orthonormal basis z_j of ker G (times position_step) with the momentum change that keeps the
+// hidden constraint, -G^T (G M^-1 G^T)^-1 K z_j, K = d(G(q) v)/dq at v = M^-1 p; and momenta M z_j
+// (times momentum_step) at fixed q. 2n x 2(n - m); G must have full rank.
+Eigen::MatrixXd constrained_tangent_basis(HolonomicConstraints& constraints, const Eigen::MatrixXd& mass,
+                                          const double* q, const double* p, double position_step, double momentum_step);
 
 // The energy error's drift over a run: a least-squares line through E - E0 against time; `trend`
 // is its change over the run, `wander` the largest distance of the error from the line. A drift

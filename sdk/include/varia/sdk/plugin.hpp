@@ -5,7 +5,7 @@
 //
 //   VARIA_PLUGIN(Class, kind, type)
 //
-// where kind is one of manifold, quadrature, lagrangian, one_step, effect, force and type is the
+// where kind is one of manifold, quadrature, lagrangian, one_step, effect, force, constraint and type is the
 // type name with '-' written as '_' (VARIA_PLUGIN(Pendulum, lagrangian, pendulum);
 // VARIA_PLUGIN(GaussLegendre, quadrature, gauss_legendre) is type "gauss-legendre").
 //

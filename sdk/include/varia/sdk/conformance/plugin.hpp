@@ -2,8 +2,8 @@
 // schema and properties are JSON objects; the schema's defaults are the constructor's defaults),
 // then the suite of its kind over the objects it makes: every quadrature of its integer
 // parameters' sweep, every Lagrangian in each context it accepts with default parameters, every
-// effect and force made from each of its schema's "examples" (or from {} without examples) in
-// each system it accepts. Kinds without a suite yet have their metadata checked only.
+// effect, force and constraint made from each of its schema's "examples" (or from {} without
+// examples) in each system it accepts. Kinds without a suite yet have their metadata checked only.
 #pragma once
 
 #include <memory>
@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "varia/sdk/conformance/constraint.hpp"
 #include "varia/sdk/conformance/effect.hpp"
 #include "varia/sdk/conformance/failures.hpp"
 #include "varia/sdk/conformance/force.hpp"
@@ -110,6 +111,30 @@ inline void check_effect_plugin(const LoadedPlugin& plugin, Failures& failures) 
                   kEffectParticles, " particles in space_dim 1 to 3");
 }
 
+// A constraint bound to each particle system of kEffectParticles particles in 1, 2 and 3
+// dimensions that it accepts, for each example; at least one must be checked.
+inline void check_constraint_plugin(const LoadedPlugin& plugin, Failures& failures) {
+  std::mt19937 engine(20261129);
+  int checked = 0;
+  for (const auto& parameters : schema_examples(plugin.parameter_schema()))
+    for (int d = 1; d <= 3; ++d) {
+      const int n = d * kEffectParticles;
+      std::shared_ptr<Constraint> constraint;
+      try {
+        constraint = plugin.create<Constraint>(parameters, {{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
+      } catch (const std::runtime_error&) {
+        continue;
+      }
+      if (constraint->bind(n, d) != nullptr) continue;
+      ++checked;
+      const Failures found = check_constraint(*constraint, n, engine);
+      for (const auto& failure : found.list())
+        failures.expect(false, parameters.dump(), " in space_dim ", d, ": ", failure);
+    }
+  failures.expect(checked > 0, "no example parameters (the schema's \"examples\", else {}) made a constraint that binds to ",
+                  kEffectParticles, " particles in space_dim 1 to 3");
+}
+
 // A force in each context Rn of dim 1 to 4 that it accepts, for each example.
 inline void check_force_plugin(const LoadedPlugin& plugin, Failures& failures) {
   std::mt19937 engine(20240611);
@@ -153,6 +178,9 @@ inline Failures check_plugin(const LoadedPlugin& plugin, std::string& checked) {
     } else if (kind == "effect") {
       check_effect_plugin(plugin, failures);
       checked += ", effect suite (coordinates, Hessian pattern and symmetry, gradient and Hessian by Taylor tests)";
+    } else if (kind == "constraint") {
+      check_constraint_plugin(plugin, failures);
+      checked += ", constraint suite (Jacobian and Hessian patterns, Jacobian and weighted Hessian by Taylor tests)";
     } else if (kind == "force") {
       check_force_plugin(plugin, failures);
       checked += ", force suite (Jacobian pattern, Jacobian by Taylor tests)";

@@ -1,0 +1,34 @@
+// A holonomic constraint g(q) = 0 of a mechanical system (spec: "Constrained systems"): m scalar
+// functions of the configuration q (n numbers) with their sparse Jacobian G = dg/dq and the Hessian
+// of sum_i lambda_i g_i for given multipliers lambda, which the constructions need for the exact
+// Newton Jacobian of the constrained discrete Euler-Lagrange equations (docs/constraints.md).
+// Model evaluations only: a construction decides where and with which multipliers g enters.
+// ABI 16.
+#pragma once
+
+#include "varia/abi/plugin_object.hpp"
+
+namespace varia {
+
+class Constraint : public PluginObject {
+ public:
+  Kind kind() const noexcept final { return Kind::constraint; }
+  // Called once, before anything else: the configuration has n numbers; where they are the
+  // positions of particles in space_dim dimensions (a particle system, Lagrangian::space_dim()),
+  // particle i is q[i * space_dim + k], else space_dim is 0. Fails (a message naming the parameter at
+  // fault) when the constraint does not apply to such a system.
+  virtual Status bind(int n, int space_dim) noexcept = 0;
+  // m, the number of scalar constraints g_i (after bind).
+  virtual int size() const noexcept = 0;
+  // The stored entries (i, j) of G_ij = dg_i/dq_j; fixed after bind, no entry twice.
+  virtual int jacobian_pattern(const int** rows, const int** cols) const noexcept = 0;
+  // The stored entries (j, k) of the n x n Hessian of sum_i lambda_i g_i (both triangles); fixed
+  // after bind, no entry twice.
+  virtual int hessian_pattern(const int** rows, const int** cols) const noexcept = 0;
+  // g(q) (m numbers) and G's values in jacobian_pattern's order; either may be null.
+  virtual Status evaluate(const double* q, double* g, double* jacobian) noexcept = 0;
+  // The Hessian of sum_i lambda_i g_i at q, its values in hessian_pattern's order.
+  virtual Status weighted_hessian(const double* q, const double* lambda, double* values) noexcept = 0;
+};
+
+}  // namespace varia

@@ -1,0 +1,205 @@
+// Holonomic constraints (spec: "Constrained systems, S2 and products"; docs/constraints.md): the
+// spherical pendulum as one particle in R^3 on a rod from the origin, against an independent
+// reference (Boost.Odeint's Runge-Kutta-Fehlberg 7(8) on the Cartesian equations with the
+// multiplier in closed form, x'' = g - lambda x, lambda = (x . g + |x'|^2) / |x|^2), and what the
+// host refuses.
+#include <doctest/doctest.h>
+
+#include <array>
+#include <boost/numeric/odeint.hpp>
+#include <cmath>
+#include <nlohmann/json.hpp>
+
+#include "assemble.hpp"
+#include "host/support.hpp"
+#include "registry.hpp"
+#include "scene.hpp"
+#include "varia/core/trajectory.hpp"
+#include "varia/core/verification.hpp"
+
+namespace varia::host {
+namespace {
+
+using nlohmann::json;
+using State6 = std::array<double, 6>;
+constexpr double kGravity = 9.81;
+
+json spherical_pendulum(int degree, double h, long steps) {
+  json document = json::parse(test::read_file(test::kSourceDir / "scenes/multibody/spherical-pendulum-rod-s1.json"));
+  document["method"] = {{"construction", "galerkin"}, {"degree", degree},
+                        {"quadrature", {{"type", "gauss-lobatto"}, {"points", degree + 1}}}};
+  document["step"] = h;
+  document.erase("t_end");
+  document["steps"] = steps;
+  return document;
+}
+
+Assembly assembled(const json& document, Registry& registry, Scene& scene) {
+  scene = parse_scene(document);
+  validate_parameters(scene, registry);
+  return assemble(scene, registry);
+}
+
+// (x, x') at time T from (x0, v0), to about 1e-14.
+State6 reference_state(const State6& start, double T) {
+  State6 z = start;
+  const auto field = [](const State6& y, State6& dy, double) {
+    const double lambda = (-kGravity * y[2] + y[3] * y[3] + y[4] * y[4] + y[5] * y[5]) /
+                          (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
+    for (int a = 0; a < 3; ++a) dy[a] = y[3 + a], dy[3 + a] = -lambda * y[a];
+    dy[5] -= kGravity;
+  };
+  namespace odeint = boost::numeric::odeint;
+  odeint::integrate_adaptive(odeint::make_controlled(1e-15, 1e-15, odeint::runge_kutta_fehlberg78<State6>()), field, z,
+                             0.0, T, 1e-3);
+  return z;
+}
+
+}  // namespace
+
+TEST_CASE("the spherical pendulum on a rod: Galerkin s = 1, 2, 3 with s + 1 Lobatto points has orders 2, 4, 6") {
+  Registry registry{Registry::search_path({})};
+  const double T = 1.0;
+  for (int s = 1; s <= 3; ++s) {
+    CAPTURE(s);
+    std::vector<double> hs, errors;
+    State6 truth{};
+    for (double h = std::array<double, 3>{0.02, 0.05, 0.1}[s - 1]; hs.size() < 4; h /= 2) {
+      Scene scene;
+      Assembly a = assembled(spherical_pendulum(s, h, std::lround(T / h)), registry, scene);
+      if (hs.empty()) {
+        for (int k = 0; k < 3; ++k) truth[k] = a.q0[k], truth[3 + k] = a.v0[k];
+        truth = reference_state(truth, T);
+      }
+      Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, h);
+      trajectory.advance(scene.steps);
+      double error = 0.0;  // m = 1: p = x'
+      for (int k = 0; k < 3; ++k)
+        error = std::max({error, std::abs(trajectory.q()[k] - truth[k]), std::abs(trajectory.p()[k] - truth[3 + k])});
+      hs.push_back(h);
+      errors.push_back(error);
+    }
+    const OrderFit fit = fit_order(hs, errors, 1e-12);
+    MESSAGE("s = ", s, ": errors ", errors[0], " .. ", errors[3], ", fitted order ", fit.slope, " on ", fit.used, " points");
+    CHECK(fit.used == 4);
+    CHECK(std::abs(fit.slope - 2 * s) <= 0.25);
+  }
+}
+
+// 10^5 steps of h = 0.01, s = 2: the constraint within 1e-12 and the hidden constraint within 1e-11
+// (the bounds), the energy E = |p|^2 / 2 + g x3 bounded: its largest error over the second
+// half of the run no more than twice that over the first (a drift would double it).
+TEST_CASE("the spherical pendulum on a rod over 1e5 steps: constraint and hidden constraint at round-off, energy bounded") {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  constexpr long kSteps = 100000;
+  Assembly a = assembled(spherical_pendulum(2, 0.01, kSteps), registry, scene);
+  Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, scene.step);
+  const auto energy = [](const Eigen::VectorXd& q, const Eigen::VectorXd& p) { return 0.5 * p.squaredNorm() + kGravity * q[2]; };
+  const double E0 = energy(a.q0, a.p0);
+  double g = 0.0, Gv = 0.0, first = 0.0, second = 0.0;
+  for (long k = 1; k <= kSteps; ++k) {
+    trajectory.step();
+    const Eigen::VectorXd& q = trajectory.q();
+    const Eigen::VectorXd& p = trajectory.p();  // m = 1: v = p
+    g = std::max(g, a.holonomic->residual(q.data()));
+    Gv = std::max(Gv, a.holonomic->velocity_residual(q.data(), p.data()));
+    double& half = k <= kSteps / 2 ? first : second;
+    half = std::max(half, std::abs(energy(q, p) - E0));
+  }
+  MESSAGE("constraint ", g, ", hidden constraint ", Gv, ", energy error ", first, " then ", second);
+  CHECK(g <= 1e-12);
+  CHECK(Gv <= 1e-11);
+  CHECK(second <= 2 * first);
+  CHECK(first <= 1e-8);
+}
+
+TEST_CASE("constraints are refused where they cannot be served, and a start off them is refused at its pointer") {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  json shooting = spherical_pendulum(1, 0.01, 10);
+  shooting["method"] = {{"construction", "one-step"}, {"one_step", {{"type", "implicit-midpoint"}}}};
+  CHECK_THROWS_WITH_AS(assembled(shooting, registry, scene), doctest::Contains("/system/constraints"), InputError);
+  json off = spherical_pendulum(1, 0.01, 10);
+  off["initial"]["q"] = {0.85, 0, -0.54};
+  CHECK_THROWS_WITH_AS(assembled(off, registry, scene), doctest::Contains("/initial/q"), InputError);
+  json across = spherical_pendulum(1, 0.01, 10);
+  across["initial"]["v"] = {0.1, 2.5, 0};
+  CHECK_THROWS_WITH_AS(assembled(across, registry, scene), doctest::Contains("/initial/v"), InputError);
+  json stray = spherical_pendulum(1, 0.01, 10);
+  stray["system"]["constraints"][0] = {{"type", "rod"}, {"between", {0, 1}}};
+  CHECK_THROWS_WITH_AS(assembled(stray, registry, scene), doctest::Contains("/system/constraints/0"), InputError);
+}
+
+}  // namespace varia::host
+
+namespace varia::host {
+namespace {
+
+// The constrained map followed by p1 -> (1 - 1e-2) p1: still on the constraint's cotangent space
+// (G M^-1 p = 0 is linear in p), but it contracts the phase-space volume: not symplectic there.
+class DampedMap final : public DiscreteHamiltonianMap {
+ public:
+  explicit DampedMap(DiscreteHamiltonianMap& map) : map_(map) {}
+  int point_size() const override { return map_.point_size(); }
+  int dim() const override { return map_.dim(); }
+  const SolverStatistics& solver_statistics() const override { return map_.solver_statistics(); }
+  const EvaluationCounters& evaluations() const override { return map_.evaluations(); }
+
+ protected:
+  void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override {
+    map_.step(q0, p0, t0, h, q1, p1);
+    for (int k = 0; k < dim(); ++k) p1[k] *= 1.0 - 1e-2;
+  }
+
+ private:
+  DiscreteHamiltonianMap& map_;
+};
+
+}  // namespace
+
+TEST_CASE("symplecticity on the constraint's cotangent bundle: holds for the constrained Galerkin map, not for a damped one") {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  Assembly a = assembled(spherical_pendulum(2, 0.01, 10), registry, scene);
+  const Eigen::MatrixXd M = Eigen::MatrixXd::Identity(3, 3);
+  const Eigen::MatrixXd tangent = constrained_tangent_basis(*a.holonomic, M, a.q0.data(), a.p0.data(), 1e-3, 2.5e-3);
+  REQUIRE(tangent.cols() == 4);
+  const Eigen::VectorXd steps = Eigen::VectorXd::Constant(6, 1e-3);
+  const auto held = symplecticity_defect(*a.map, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps, tangent);
+  CHECK(held.defect <= 1e-9);
+  DampedMap damped(*a.map);
+  const auto broken = symplecticity_defect(damped, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps, tangent);
+  CHECK(broken.defect >= 1e-3);
+  // On the whole of T*R^3 the constrained map is not symplectic (it maps onto the bundle): the
+  // unrestricted measurement would call a correct integrator wrong, which is why verify restricts it.
+  const auto whole = symplecticity_defect(*a.map, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps);
+  CHECK(whole.defect >= 1e-3);
+}
+
+TEST_CASE("varia verify holds every predicted property of the constrained spherical pendulum, s = 1, 2, 3") {
+  for (int s = 1; s <= 3; ++s) {
+    const auto outcome = test::run_varia("verify scenes/multibody/spherical-pendulum-rod-s" + std::to_string(s) + ".json");
+    CAPTURE(outcome.out);
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == 0);
+    CHECK(test::contains(outcome.out, "global_order"));
+  }
+}
+
+}  // namespace varia::host
+
+namespace varia::host {
+
+// In TEST_SUITE("long"), names without commas (doctest_discover_tests).
+TEST_SUITE("long") {
+  TEST_CASE("varia verify holds every predicted property of the 100-link rod chain") {
+    const auto outcome = test::run_varia("verify scenes/multibody/rod-chain-100.json");
+    CAPTURE(outcome.out);
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == 0);
+    CHECK(test::contains(outcome.out, "symplectic"));
+  }
+}
+
+}  // namespace varia::host
