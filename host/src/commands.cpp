@@ -25,21 +25,12 @@ namespace {
 
 Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
 
-// Loads and assembles a scene; every InputError about it is prefixed with the scene's file name.
-struct Prepared {
-  Scene scene;
-  Assembly assembly;
-};
-
+// Loads and assembles a scene file; every InputError about it is prefixed with the file's name.
 Prepared prepare(const std::string& scene_file, Registry& registry) {
   try {
-    Scene scene = load_scene(scene_file, registry);
-    Assembly assembly = assemble(scene, registry);
-    return Prepared{std::move(scene), std::move(assembly)};
+    return prepare_document(read_json_file(scene_file), registry);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", scene_file, e.what()));
-  } catch (const std::invalid_argument& e) {  // a construction refusing the parts it was given
-    throw InputError(fmt::format("{}: /method: {}", scene_file, e.what()));
   }
 }
 
@@ -109,17 +100,6 @@ void print_plugins_table(const std::vector<PluginRecord>& records, const std::ve
   for (const auto& r : refused) fmt::print(results(), "  {}: {}\n", r.file.string(), r.reason);
 }
 
-nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records) {
-  auto array = nlohmann::ordered_json::array();
-  for (const auto& r : records)
-    array.push_back({{"kind", r.kind},
-                     {"type", r.type},
-                     {"version", r.version},
-                     {"file", r.file.string()},
-                     {"properties", r.properties},
-                     {"parameter_schema", r.parameter_schema}});
-  return array;
-}
 
 // ---- ld ------------------------------------------------------------------------------------------
 
@@ -152,6 +132,29 @@ Eigen::VectorXd parse_point(const std::string& text, Manifold& manifold, const s
 }
 
 }  // namespace
+
+nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records) {
+  auto array = nlohmann::ordered_json::array();
+  for (const auto& r : records)
+    array.push_back({{"kind", r.kind},
+                     {"type", r.type},
+                     {"version", r.version},
+                     {"file", r.file.string()},
+                     {"properties", r.properties},
+                     {"parameter_schema", r.parameter_schema}});
+  return array;
+}
+
+Prepared prepare_document(const json& document, Registry& registry) {
+  try {
+    Scene scene = parse_scene(document);
+    validate_parameters(scene, registry);
+    Assembly assembly = assemble(scene, registry);
+    return Prepared{std::move(scene), std::move(assembly)};
+  } catch (const std::invalid_argument& e) {  // a construction refusing the parts it was given
+    throw InputError(fmt::format("/method: {}", e.what()));
+  }
+}
 
 int with_registry(const CommonOptions& common, const std::function<int(Registry&)>& body) {
   Registry registry = make_registry(common);
@@ -213,33 +216,43 @@ int command_run(const CommonOptions& common, const std::string& scene_file, cons
   });
 }
 
+nlohmann::ordered_json discrete_lagrangian(Prepared& prepared, const LdOptions& options) {
+  Assembly& a = prepared.assembly;
+  if (a.discrete_lagrangian == nullptr)
+    throw InputError(fmt::format("/method/construction: construction '{}' has no discrete Lagrangian",
+                                 prepared.scene.construction->name()));
+  if (!(options.h > 0.0) || !std::isfinite(options.h))
+    throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
+  const Eigen::VectorXd q0 = parse_point(options.q0, *a.manifold, prepared.scene.manifold.type, "--q0");
+  const Eigen::VectorXd q1 = parse_point(options.q1, *a.manifold, prepared.scene.manifold.type, "--q1");
+  double ld = 0.0;
+  Eigen::VectorXd d1(a.map->dim()), d2(a.map->dim());
+  a.discrete_lagrangian->evaluate(q0.data(), q1.data(), options.h, &ld, d1.data(), d2.data());
+  if (!std::isfinite(ld) || !d1.allFinite() || !d2.allFinite())  // as run does with a non-finite state
+    throw NumericalFailure(fmt::format("a non-finite value of L_d or its derivatives at --q0 {} --q1 {} --h {} "
+                                       "(Ld = {}, D1 = [{}], D2 = [{}])",
+                                       options.q0, options.q1, options.h, ld, fmt::join(as_vector(d1), ", "),
+                                       fmt::join(as_vector(d2), ", ")),
+                           std::nan(""));
+  return nlohmann::ordered_json{{"Ld", ld}, {"D1", as_vector(d1)}, {"D2", as_vector(d2)}};
+}
+
 int command_ld(const CommonOptions& common, const std::string& scene_file, const LdOptions& options) {
   return with_registry(common, [&](Registry& registry) {
     Prepared prepared = prepare(scene_file, registry);
-    Assembly& a = prepared.assembly;
-    if (a.discrete_lagrangian == nullptr)
-      throw InputError(fmt::format("{}: /method/construction: construction '{}' has no discrete Lagrangian",
-                                   scene_file, prepared.scene.construction->name()));
-    if (!(options.h > 0.0) || !std::isfinite(options.h))
-      throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
-    const Eigen::VectorXd q0 = parse_point(options.q0, *a.manifold, prepared.scene.manifold.type, "--q0");
-    const Eigen::VectorXd q1 = parse_point(options.q1, *a.manifold, prepared.scene.manifold.type, "--q1");
-    double ld = 0.0;
-    Eigen::VectorXd d1(a.map->dim()), d2(a.map->dim());
-    a.discrete_lagrangian->evaluate(q0.data(), q1.data(), options.h, &ld, d1.data(), d2.data());
-    if (!std::isfinite(ld) || !d1.allFinite() || !d2.allFinite())  // as run does with a non-finite state
-      throw NumericalFailure(fmt::format("a non-finite value of L_d or its derivatives at --q0 {} --q1 {} --h {} "
-                                         "(Ld = {}, D1 = [{}], D2 = [{}])",
-                                         options.q0, options.q1, options.h, ld, fmt::join(as_vector(d1), ", "),
-                                         fmt::join(as_vector(d2), ", ")),
-                             std::nan(""));
+    nlohmann::ordered_json result;
+    try {
+      result = discrete_lagrangian(prepared, options);
+    } catch (const InputError& e) {
+      if (e.what()[0] != '/') throw;
+      throw InputError(fmt::format("{}: {}", scene_file, e.what()));
+    }
     if (options.json) {
-      const nlohmann::ordered_json result{{"Ld", ld}, {"D1", as_vector(d1)}, {"D2", as_vector(d2)}};
       fmt::print(results(), "{}\n", result.dump());
       return 0;
     }
-    fmt::print(results(), "Ld = {}\nD1 = [{}]\nD2 = [{}]\n", ld, fmt::join(as_vector(d1), ", "),
-               fmt::join(as_vector(d2), ", "));
+    fmt::print(results(), "Ld = {}\nD1 = [{}]\nD2 = [{}]\n", result["Ld"].get<double>(),
+               fmt::join(result["D1"].get<std::vector<double>>(), ", "), fmt::join(result["D2"].get<std::vector<double>>(), ", "));
     return 0;
   });
 }

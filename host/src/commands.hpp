@@ -8,9 +8,20 @@
 #include <string>
 #include <vector>
 
+#include "registry.hpp"
 #include "run.hpp"
 
 namespace varia::host {
+
+// A scene document checked and assembled (InputError at its JSON pointer, as validate reports it).
+struct Prepared {
+  Scene scene;
+  Assembly assembly;
+};
+Prepared prepare_document(const nlohmann::json& document, Registry& registry);
+
+// The plugins as `plugins --json` lists them.
+nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records);
 
 struct CommonOptions {
   std::vector<std::string> plugin_paths;  // --plugin-path, repeatable
@@ -38,6 +49,9 @@ struct LdOptions {
   bool json = false;
 };
 int command_ld(const CommonOptions& common, const std::string& scene_file, const LdOptions& options);
+// {"Ld", "D1", "D2"} at the points and step of `options` (InputError at --q0, --q1, --h or
+// /method/construction; NumericalFailure for a non-finite value).
+nlohmann::ordered_json discrete_lagrangian(Prepared& prepared, const LdOptions& options);
 // Prints the table of checks (and writes them as JSON when json_file is not empty); 1 when a
 // property the theorems predict was measured not to hold.
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,

@@ -249,10 +249,12 @@ std::shared_ptr<Registry::Loaded> Registry::load(const fs::path& file, const Sym
 }
 
 std::vector<fs::path> Registry::search_path(const std::vector<std::string>& plugin_paths) {
+  return search_path(plugin_paths, boost::dll::program_location().parent_path() / ".." / "lib" / "varia" / "plugins");
+}
+
+std::vector<fs::path> Registry::search_path(const std::vector<std::string>& plugin_paths, const fs::path& bundled) {
   // Spec "Build layout": bundled plugins, then --plugin-path, then VARIA_PLUGIN_PATH.
-  std::vector<fs::path> directories{
-      (boost::dll::program_location().parent_path() / ".." / "lib" / "varia" / "plugins")
-          .lexically_normal()};
+  std::vector<fs::path> directories{bundled.lexically_normal()};
   for (const auto& path : plugin_paths) directories.emplace_back(path);
   for (fs::path& path : path_list("VARIA_PLUGIN_PATH")) directories.push_back(std::move(path));
   return directories;

@@ -78,6 +78,9 @@ class Registry {
   // The directories searched, in order: the bundled plugins (found relative to the running
   // executable), each of `plugin_paths`, then VARIA_PLUGIN_PATH (colon-separated).
   static std::vector<std::filesystem::path> search_path(const std::vector<std::string>& plugin_paths);
+  // The same with the bundled plugins' directory given (the Python module finds them beside itself).
+  static std::vector<std::filesystem::path> search_path(const std::vector<std::string>& plugin_paths,
+                                                        const std::filesystem::path& bundled);
   explicit Registry(std::vector<std::filesystem::path> directories);
   ~Registry();
   Registry(const Registry&) = delete;

@@ -239,6 +239,7 @@ class Stepper {
     else if (options.out)
       csv_ = std::make_unique<CsvWriter>(*options.out);
     if (options.plot) plot_ = std::make_unique<PlotRecorder>(*a.manifold, scene.observe.energy, written_rows(scene));
+    recorder_ = options.rows;
   }
 
   PlotRecorder* plot() { return plot_.get(); }
@@ -276,6 +277,7 @@ class Stepper {
   void start_output() {
     if (csv_) csv_->header(csv_columns(a_.map->point_size(), a_.map->dim(), observer_));
     if (h5_) h5_->header(a_.map->point_size(), a_.map->dim(), observer_.columns());
+    if (recorder_ != nullptr) recorder_->columns(a_.map->point_size(), a_.map->dim(), observer_.columns());
     observe_and_write();
   }
 
@@ -286,7 +288,7 @@ class Stepper {
     if (observing_) return 0;
     const long k = trajectory_.steps();
     long due = scene_.steps;
-    if (csv_ || h5_ || plot_) due = std::min(due, (k / scene_.output_every + 1) * scene_.output_every);
+    if (csv_ || h5_ || plot_ || recorder_ != nullptr) due = std::min(due, (k / scene_.output_every + 1) * scene_.output_every);
     return std::clamp(due - k - 1, 0L, kStretch);
   }
 
@@ -316,6 +318,7 @@ class Stepper {
     if (h5_ && due)
       h5_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()), values);
     if (plot_ && due) plot_->record(trajectory_.t(), q, p, values);
+    if (recorder_ != nullptr && due) recorder_->row(trajectory_.t(), q.data(), p.data(), values);
   }
 
   // The energy's sane range (Observer::check_energy_range) is checked for a system without forces
@@ -339,6 +342,7 @@ class Stepper {
   std::unique_ptr<CsvWriter> csv_;
   std::unique_ptr<Hdf5Writer> h5_;
   std::unique_ptr<PlotRecorder> plot_;
+  TrajectoryRecorder* recorder_ = nullptr;
 };
 
 // The failure's residual in the run record: its number, or where it is not finite (a non-finite
@@ -381,6 +385,7 @@ RunOutcome run_scene(const Scene& scene, Assembly& assembly, const Registry& reg
     json record = run_record(scene, assembly, stepper.observer(), stepper.state(), stepper.outcome(), registry);
     for (const auto& [key, value] : note.items()) record[key] = value;
     if (options.summary) write_json_file(*options.summary, record, "--summary");
+    if (options.record != nullptr) *options.record = record;
   };
   std::optional<Failure> failure;
   try {
@@ -409,9 +414,9 @@ RunOutcome run_scene(const Scene& scene, Assembly& assembly, const Registry& reg
   }
   if (options.plot) stepper.plot()->write(*options.plot);
   if (failure)
-    throw NumericalFailure(fmt::format("step {} (from t = {:.10g}) failed: {}; residual {:.3e}", failure->step,
-                                       failure->t, failure->message, failure->residual),
-                           failure->residual, failure->origin);
+    throw RunFailure(fmt::format("step {} (from t = {:.10g}) failed: {}; residual {:.3e}", failure->step, failure->t,
+                                 failure->message, failure->residual),
+                     failure->residual, failure->origin, failure->step, failure->t);
   // With the trajectory on stdout, the human summary goes to stderr.
   if (!options.quiet) print_human_summary(options.out && *options.out == "-" ? stderr : results(), scene, assembly,
                                           stepper.observer(), stepper.state(), stepper.outcome());
