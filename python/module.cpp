@@ -195,4 +195,14 @@ PYBIND11_MODULE(_varia, m) {
   m.def("run", &varia::host::run);
   m.def("verify", &varia::host::verify);
   m.def("ld", &varia::host::ld);
+  m.def("sdk_include_dirs", [] {  // the SDK's headers, for varia.lagrangian's compiler
+    std::vector<std::string> dirs;
+    std::string all = VARIA_SDK_INCLUDE_DIRS;
+    for (std::size_t start = 0, end; start <= all.size(); start = end + 1) {
+      end = all.find(':', start);
+      if (end == std::string::npos) end = all.size();
+      dirs.push_back(all.substr(start, end - start));
+    }
+    return dirs;
+  });
 }

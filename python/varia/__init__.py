@@ -17,7 +17,8 @@ import numpy as np
 
 from . import _varia
 
-__all__ = ["SceneError", "NumericalFailure", "PluginFault", "Run", "plugins", "validate", "run", "verify", "ld"]
+__all__ = ["SceneError", "NumericalFailure", "PluginFault", "Run", "plugins", "validate", "run", "verify", "ld",
+           "lagrangian"]
 
 
 class SceneError(Exception):
@@ -116,3 +117,15 @@ def ld(scene, q0, q1, h):
     """{"Ld", "D1", "D2"} of the scene's discrete Lagrangian, as `varia ld --json` prints them."""
     values = [float(x) for x in np.ravel(q0)], [float(x) for x in np.ravel(q1)]
     return json.loads(_call(_varia.ld, *_scene(scene), *values, float(h)))
+
+
+def lagrangian(name, L, q, v, parameters=None, symmetry=None, directory=None):
+    """Makes the SymPy expression L in the symbols q and v (lists) and in `parameters` (a dict:
+    symbol -> default) a Lagrangian plugin of type `name` on Rn with dim len(q), usable by the
+    process's later scenes; `directory` also receives its file (for --plugin-path). Its
+    derivatives are exact (the SDK's automatic differentiation of the generated model), a constant
+    mass matrix is detected; the file is compiled once and cached by the expression's hash.
+    Returns the plugin file. (varia/codegen.py; `symmetry` is not supported yet.)"""
+    from .codegen import lagrangian as generate  # SymPy is imported only here
+
+    return generate(name, L, q, v, parameters, symmetry, directory)

@@ -1,0 +1,77 @@
+"""varia.lagrangian (docs/python.md): a SymPy Lagrangian compiled into a plugin. The double
+pendulum written in SymPy takes the bundled double-pendulum's steps; the Henon-Heiles system with
+Galerkin degree 1 and the trapezoid rule is explicit (its constant mass matrix detected: no
+Newton iteration) and is a hand-written Stormer-Verlet's. Compiled into a cache of the test's own,
+so the first call compiles (the time is printed, not asserted) and the second finds it."""
+
+import os
+import tempfile
+import time
+import unittest
+
+import numpy as np
+import sympy as sp
+
+import varia
+
+
+class LagrangianTest(unittest.TestCase):
+    @classmethod
+    def setUpClass(cls):
+        cls.cache = tempfile.TemporaryDirectory()
+        os.environ["XDG_CACHE_HOME"] = cls.cache.name
+
+    @classmethod
+    def tearDownClass(cls):
+        cls.cache.cleanup()
+
+    def test_a_sympy_double_pendulum_takes_the_bundled_double_pendulums_steps(self):
+        q1, q2, v1, v2, m1, m2, l1, l2, g = sp.symbols("q1 q2 v1 v2 m1 m2 l1 l2 g")
+        L = ((m1 + m2) / 2 * l1**2 * v1**2 + m2 / 2 * l2**2 * v2**2 + m2 * l1 * l2 * v1 * v2 * sp.cos(q1 - q2)
+             + (m1 + m2) * g * l1 * sp.cos(q1) + m2 * g * l2 * sp.cos(q2))
+        parameters = {m1: 1, m2: 0.5, l1: 1, l2: 0.7, g: 9.81}
+        start = time.monotonic()
+        plugin = varia.lagrangian("sympy-double-pendulum", L, [q1, q2], [v1, v2], parameters)
+        compiled = time.monotonic() - start
+        start = time.monotonic()
+        self.assertEqual(varia.lagrangian("sympy-double-pendulum", L, [q1, q2], [v1, v2], parameters), plugin)
+        print(f"\ncompiled in {compiled:.1f} s, found in the cache in {time.monotonic() - start:.3f} s")
+        scene = {"system": {"manifold": {"type": "Rn", "dim": 2},
+                            "lagrangian": {"type": "double-pendulum", "mass2": 0.5, "length2": 0.7, "gravity": 9.81}},
+                 "method": {"construction": "galerkin", "degree": 2, "quadrature": {"type": "gauss-lobatto", "points": 3}},
+                 "initial": {"q": [1.0, 0.5], "v": [0.0, 0.3]}, "step": 0.01, "steps": 2000}
+        bundled = varia.run(scene)
+        scene["system"]["lagrangian"] = {"type": "sympy-double-pendulum"}
+        generated = varia.run(scene)
+        difference = max(np.abs(bundled.q - generated.q).max(), np.abs(bundled.p - generated.p).max())
+        print(f"largest difference from the bundled double-pendulum over 2000 steps: {difference:.3g}")
+        self.assertLessEqual(difference, 1e-11)
+
+    def test_henon_heiles_with_the_trapezoid_rule_is_explicit_stormer_verlet(self):
+        q1, q2, v1, v2 = sp.symbols("q1 q2 v1 v2")
+        L = (v1**2 + v2**2) / 2 - (q1**2 + q2**2) / 2 - q1**2 * q2 + q2**3 / 3
+        varia.lagrangian("sympy-henon-heiles", L, [q1, q2], [v1, v2])
+        h, steps, q, p = 0.05, 400, np.array([0.1, -0.2]), np.array([0.3, 0.15])
+        run = varia.run({"system": {"manifold": {"type": "Rn", "dim": 2}, "lagrangian": {"type": "sympy-henon-heiles"}},
+                         "method": {"construction": "galerkin", "degree": 1, "quadrature": {"type": "trapezoid"}},
+                         "initial": {"q": list(q), "p": list(p)}, "step": h, "steps": steps})
+        self.assertEqual(run.record["newton_iterations"]["max"], 0)
+
+        def force(x):
+            return np.array([-x[0] - 2 * x[0] * x[1], -x[1] - x[0] ** 2 + x[1] ** 2])
+
+        for _ in range(steps):  # Stormer-Verlet, written here
+            half = p + h / 2 * force(q)
+            q = q + h * half
+            p = half + h / 2 * force(q)
+        self.assertLessEqual(np.abs(run.q[-1] - q).max(), 1e-13)
+        self.assertLessEqual(np.abs(run.p[-1] - p).max(), 1e-13)
+
+    def test_symbols_that_are_not_q_v_or_parameters_are_refused(self):
+        x, v, k = sp.symbols("x v k")
+        with self.assertRaises(ValueError):
+            varia.lagrangian("sympy-unknown", v**2 / 2 - k * x**2 / 2, [x], [v])
+
+
+if __name__ == "__main__":
+    unittest.main()
