@@ -21,6 +21,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "cost.hpp"
 #include "errors.hpp"
 #include "json_reader.hpp"
 #include "memory.hpp"
@@ -38,10 +39,12 @@ struct FailureTag {};
 py::handle failure_type;  // _varia.Failure, set when the module is made
 
 // The bundled plugins: build/lib/varia/plugins from build/python/varia/_varia*.so.
-Registry make_registry() {
+std::filesystem::path bundled_plugins() {
   const auto here = std::filesystem::path(boost::dll::this_line_location().string()).parent_path();
-  return Registry(Registry::search_path({}, here / ".." / ".." / "lib" / "varia" / "plugins"));
+  return (here / ".." / ".." / "lib" / "varia" / "plugins").lexically_normal();
 }
+
+Registry make_registry() { return Registry(Registry::search_path({}, bundled_plugins())); }
 
 // A scene given as a file ("path") or as JSON text ("text"), read as the CLI reads files.
 json scene_document(const std::string& kind, const std::string& value) {
@@ -182,6 +185,17 @@ std::string ld(const std::string& kind, const std::string& value, const std::vec
   });
 }
 
+// `varia cost` on scene files, writing cost.csv, cost.json and cost.svg into `out`.
+void cost(const std::vector<std::string>& files, const std::vector<double>& h, const std::string& out) {
+  guarded([&](Registry&) {
+    CostOptions options;
+    options.out = out;
+    options.h = h;
+    options.quiet = true;
+    command_cost(CommonOptions{{bundled_plugins().string()}}, files, options);
+  });
+}
+
 }  // namespace
 }  // namespace varia::host
 
@@ -195,6 +209,7 @@ PYBIND11_MODULE(_varia, m) {
   m.def("run", &varia::host::run);
   m.def("verify", &varia::host::verify);
   m.def("ld", &varia::host::ld);
+  m.def("cost", &varia::host::cost);
   m.def("sdk_include_dirs", [] {  // the SDK's headers, for varia.lagrangian's compiler
     std::vector<std::string> dirs;
     std::string all = VARIA_SDK_INCLUDE_DIRS;

@@ -12,13 +12,14 @@ and the same code as the CLI: `run` returns the numbers the CLI writes, to the b
 
 import json
 import os
+import tempfile
 
 import numpy as np
 
 from . import _varia
 
 __all__ = ["SceneError", "NumericalFailure", "PluginFault", "Run", "plugins", "validate", "run", "verify", "ld",
-           "lagrangian"]
+           "cost", "lagrangian"]
 
 
 class SceneError(Exception):
@@ -117,6 +118,27 @@ def ld(scene, q0, q1, h):
     """{"Ld", "D1", "D2"} of the scene's discrete Lagrangian, as `varia ld --json` prints them."""
     values = [float(x) for x in np.ravel(q0)], [float(x) for x in np.ravel(q1)]
     return json.loads(_call(_varia.ld, *_scene(scene), *values, float(h)))
+
+
+def cost(scenes, h=None):
+    """What accuracy costs, as `varia cost` measures it: the dict of its cost.json (per method:
+    the predicted order, the fitted slope, the rows of the sweep, the reference used). `scenes`:
+    a list of scenes (dicts, JSON texts or paths); `h`: the step sizes, as `--h`."""
+    with tempfile.TemporaryDirectory() as directory:
+        files = []
+        for k, scene in enumerate(scenes):
+            kind, value = _scene(scene)
+            if kind == "path":
+                files.append(value)
+                continue
+            files.append(os.path.join(directory, f"scene{k}.json"))  # a method's name: the scene's "name", else this stem
+            with open(files[-1], "w") as f:
+                f.write(value)
+        out = os.path.join(directory, "out")
+        os.mkdir(out)
+        _call(_varia.cost, files, [float(x) for x in (h or [])], out)
+        with open(os.path.join(out, "cost.json")) as f:
+            return json.load(f)
 
 
 def lagrangian(name, L, q, v, parameters=None, symmetry=None, directory=None):

@@ -105,6 +105,20 @@ class CommandsTest(unittest.TestCase):
         self.assertEqual(varia.verify(scene), expected)
 
 
+class CostTest(unittest.TestCase):
+    def test_cost_is_the_cli_cost_json(self):
+        scenes = ["scenes/pendulum-galerkin-s1.json", "scenes/pendulum-galerkin-s2.json"]
+        with tempfile.TemporaryDirectory() as directory:
+            self.assertEqual(cli("cost", *scenes, "--h", "0.2,0.1,0.05,0.025", "--out", directory, "--quiet").returncode, 0)
+            with open(os.path.join(directory, "cost.json")) as f:
+                expected = json.load(f)
+        self.assertEqual(varia.cost(scenes, h=[0.2, 0.1, 0.05, 0.025]), expected)
+        with open(scenes[1]) as f:
+            from_dict = varia.cost([json.load(f)], h=[0.2, 0.1, 0.05, 0.025])["methods"][0]
+        self.assertEqual(from_dict["method"], "scene0")
+        self.assertEqual(from_dict["fitted_slope"], expected["methods"][1]["fitted_slope"])
+
+
 class DocsTest(unittest.TestCase):
     def test_the_examples_of_docs_python_md_run(self):
         with open("docs/python.md") as f:
