@@ -147,7 +147,9 @@ def lagrangian(name, L, q, v, parameters=None, symmetry=None, directory=None):
     process's later scenes; `directory` also receives its file (for --plugin-path). Its
     derivatives are exact (the SDK's automatic differentiation of the generated model), a constant
     mass matrix is detected; the file is compiled once and cached by the expression's hash.
-    Returns the plugin file. (varia/codegen.py; `symmetry` is not supported yet.)"""
+    `symmetry`: a generator A (an n x n matrix) of a linear action q -> exp(t A) q, v alike, or a
+    list of them; the plugin declares it with the momentum map J = <dL/dv, A q>. Returns the
+    plugin file. (varia/codegen.py)"""
     from .codegen import lagrangian as generate  # SymPy is imported only here
 
     return generate(name, L, q, v, parameters, symmetry, directory)

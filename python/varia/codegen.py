@@ -3,7 +3,10 @@
 The expression is printed once as C++, its common subexpressions shared (sympy.cse), into the
 model function of an `sdk::AutodiffLagrangian<Model, n, n>`: the SDK differentiates that one
 function exactly by forward-mode automatic differentiation, at every order and scalar the
-constructions need, and reads a constant mass matrix off the model by itself. The source is
+constructions need, and reads a constant mass matrix off the model by itself. A symmetry is
+given as generators A_k of a linear action on q (and v alike); the plugin declares it, with the
+momentum map J_k = <dL/dv, A_k q>, so that `verify` predicts momentum conservation and measures
+the invariance of L_d (a generator that is not a symmetry of L is reported as not holding). The source is
 compiled against the SDK's headers into a plugin file cached by the hash of its text (and of the
 compiler's command), and the directory holding it is put on VARIA_PLUGIN_PATH, so that later
 scenes of the process name the type.
@@ -15,6 +18,7 @@ import os
 import shutil
 import subprocess
 
+import numpy as np
 import sympy
 from sympy.printing.c import C99CodePrinter
 
@@ -39,6 +43,8 @@ class _Printer(C99CodePrinter):
             return "(" + product + ")" if exponent > 0 else "(1.0/(" + product + "))"
         if exponent == sympy.Rational(1, 2):
             return "sqrt(" + self._print(base) + ")"
+        if exponent == sympy.Rational(-1, 2):
+            return "(1.0/sqrt(" + self._print(base) + "))"
         return "pow(" + self._print(base) + ", T(" + self._print(sympy.Float(exponent)) + "))"
 
 
@@ -48,7 +54,58 @@ def _identifier(name):
     return name.replace("-", "_")
 
 
-def _source(name, L, q, v, parameters):
+def _generators(symmetry, n):
+    """The symmetry as a list of n x n matrices A_k (floats): one matrix, or a list of them."""
+    if symmetry is None:
+        return []
+    matrices = [symmetry] if np.asarray(symmetry, dtype=object).ndim == 2 else list(symmetry)
+    generators = [np.array(sympy.Matrix(A).evalf(), dtype=float) for A in matrices]
+    for A in generators:
+        if A.shape != (n, n) or not np.all(np.isfinite(A)):
+            raise ValueError(f"symmetry: each generator must be a finite {n} x {n} matrix")
+    return generators
+
+
+def _symmetry_source(generators, n):
+    """The declared symmetry: the linear action q -> exp(sum_k t_k A_k) q (v alike), its momentum
+    map J_k = <dL/dv, A_k q> (Noether), and the action of a group element drawn from a seed."""
+    if not generators:
+        return ""
+    rows = ",\n      ".join("{" + ", ".join(repr(float(x)) for x in A.flatten()) + "}" for A in generators)
+    return f"""
+  const char* symmetry_group() const noexcept override {{ return "linear ({len(generators)} generator{'s' if len(generators) > 1 else ''}, varia.lagrangian)"; }}
+  int momentum_size() const noexcept override {{ return {len(generators)}; }}
+  varia::Status momentum(const double* q, const double* v, double* J) noexcept override {{
+    double gradient[2 * {n}];
+    if (const varia::Status failed = evaluate(q, v, nullptr, gradient, nullptr)) return failed;
+    for (int k = 0; k < {len(generators)}; ++k) {{
+      const Eigen::Map<const Eigen::Matrix<double, {n}, {n}, Eigen::RowMajor>> A(kGenerators[k]);
+      J[k] = Eigen::Map<const Eigen::Matrix<double, {n}, 1>>(gradient + {n}).dot(A * Eigen::Map<const Eigen::Matrix<double, {n}, 1>>(q));
+    }}
+    return nullptr;
+  }}
+  varia::Status act(unsigned seed, const double* q, const double* v, double* gq, double* gv) noexcept override {{
+    return varia::sdk::guarded(error_, [&] {{
+      std::mt19937 engine(seed);
+      std::uniform_real_distribution<double> angle(-1.0, 1.0);
+      Eigen::Matrix<double, {n}, {n}> X = Eigen::Matrix<double, {n}, {n}>::Zero();
+      for (int k = 0; k < {len(generators)}; ++k)
+        X += angle(engine) * Eigen::Map<const Eigen::Matrix<double, {n}, {n}, Eigen::RowMajor>>(kGenerators[k]);
+      const Eigen::Matrix<double, {n}, {n}> g = X.exp();
+      const Eigen::Matrix<double, {n}, 1> x = g * Eigen::Matrix<double, {n}, 1>{{Eigen::Map<const Eigen::Matrix<double, {n}, 1>>{{q}}}};
+      const Eigen::Matrix<double, {n}, 1> w = g * Eigen::Matrix<double, {n}, 1>{{Eigen::Map<const Eigen::Matrix<double, {n}, 1>>{{v}}}};
+      Eigen::Map<Eigen::Matrix<double, {n}, 1>>{{gq}} = x;
+      Eigen::Map<Eigen::Matrix<double, {n}, 1>>{{gv}} = w;
+    }});
+  }}
+
+ private:
+  static constexpr double kGenerators[{len(generators)}][{n * n}] = {{
+      {rows}}};
+"""
+
+
+def _source(name, L, q, v, parameters, generators):
     n = len(q)
     names = {symbol: f"q({i})" for i, symbol in enumerate(q)}
     names.update({symbol: f"v({i})" for i, symbol in enumerate(v)})
@@ -70,11 +127,14 @@ def _source(name, L, q, v, parameters):
     members = "".join(f"  double p_{k}_;\n" for k in range(len(parameters)))
     reads = "".join(
         f",\n        p_{k}_(parameters.value({json.dumps(str(s))}, {float(d)!r}))" for k, (s, d) in enumerate(parameters.items()))
-    properties = {"lagrangian": str(L), "generated": "varia.lagrangian (SymPy)", "manifold": f"Rn, dim {n}"}
+    properties = {"lagrangian": str(L), "generated": "varia.lagrangian (SymPy)", "manifold": f"Rn, dim {n}",
+                  "symmetry": "linear, generators " + json.dumps([A.tolist() for A in generators]) if generators else "none"}
     return f"""// Generated by varia.lagrangian from a SymPy expression; do not edit.
 #include <cmath>
+#include <random>
 #include <stdexcept>
 #include <string>
+#include <unsupported/Eigen/MatrixFunctions>
 
 #include "varia/sdk/autodiff_lagrangian.hpp"
 
@@ -99,7 +159,7 @@ class Generated final : public varia::sdk::AutodiffLagrangian<Generated, {n}, {n
     using std::atan; using std::cosh; using std::sinh; using std::tanh;
 {body}    return {printer.doprint(reduced)};
   }}
-
+{_symmetry_source(generators, n)}
  private:
 {members}}};
 
@@ -126,13 +186,11 @@ def _register(name, directory):
 
 
 def lagrangian(name, L, q, v, parameters=None, symmetry=None, directory=None):
-    if symmetry is not None:
-        raise NotImplementedError("varia.lagrangian: a declared symmetry is not supported yet (docs/python.md)")
     q, v = list(q), list(v)
     if len(q) != len(v) or not q:
         raise ValueError("q and v must be lists of the same positive length")
     parameters = dict(parameters or {})
-    source = _source(name, sympy.sympify(L), q, v, parameters)
+    source = _source(name, sympy.sympify(L), q, v, parameters, _generators(symmetry, len(q)))
     cache = os.path.join(os.environ.get("XDG_CACHE_HOME", os.path.expanduser("~/.cache")), "varia", "lagrangians")
     key = hashlib.sha256((source + "\0" + " ".join(_compile_command("", ""))).encode()).hexdigest()[:24]
     where = os.path.join(cache, key)

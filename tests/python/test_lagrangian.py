@@ -67,6 +67,24 @@ class LagrangianTest(unittest.TestCase):
         self.assertLessEqual(np.abs(run.q[-1] - q).max(), 1e-13)
         self.assertLessEqual(np.abs(run.p[-1] - p).max(), 1e-13)
 
+    def test_a_declared_rotation_is_verified_and_a_false_symmetry_is_reported_as_not_holding(self):
+        x, y, u, w = sp.symbols("x y u w")
+        L = (u**2 + w**2) / 2 - (x**2 + y**2) ** 2 / 4  # an isotropic quartic well: rotations about the origin
+        scene = {"system": {"manifold": {"type": "Rn", "dim": 2}, "lagrangian": {"type": "sympy-quartic"}},
+                 "method": {"construction": "galerkin", "degree": 2, "quadrature": {"type": "gauss-lobatto", "points": 3}},
+                 "initial": {"q": [1.0, 0.0], "v": [0.0, 0.8]}, "step": 0.05, "steps": 200, "observe": ["momentum"]}
+        varia.lagrangian("sympy-quartic", L, [x, y], [u, w], symmetry=[[0, -1], [1, 0]])
+        checks = {c["name"]: c for c in varia.verify(scene)["checks"]}
+        for name in ("g_invariant", "momentum_conserved"):
+            self.assertTrue(checks[name]["predicted"], name)
+            self.assertTrue(checks[name]["holds"], name)
+        run = varia.run(scene)
+        self.assertLessEqual(np.abs(run.observables["momentum0"] - 0.8).max(), 1e-13)  # J = x w - y u
+        varia.lagrangian("sympy-quartic", L, [x, y], [u, w], symmetry=[[1, 0], [0, -1]])  # a squeeze: no symmetry
+        checks = {c["name"]: c for c in varia.verify(scene)["checks"]}
+        self.assertTrue(checks["g_invariant"]["predicted"])
+        self.assertFalse(checks["g_invariant"]["holds"])
+
     def test_symbols_that_are_not_q_v_or_parameters_are_refused(self):
         x, v, k = sp.symbols("x v k")
         with self.assertRaises(ValueError):
