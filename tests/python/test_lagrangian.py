@@ -85,6 +85,29 @@ class LagrangianTest(unittest.TestCase):
         self.assertTrue(checks["g_invariant"]["predicted"])
         self.assertFalse(checks["g_invariant"]["holds"])
 
+    def test_the_spherical_pendulum_in_angles_warns_through_the_pole_region_and_on_a_rod_it_does_not(self):
+        # Issue #40 item 5: in the angles (theta from the upward vertical, phi), a small azimuthal
+        # velocity swings the bob near the lower pole, where phi' = p_phi / sin^2 theta is large;
+        # the same motion as a point on a rod has no such chart.
+        theta, phi, u, w = sp.symbols("theta phi u w")
+        L = (u**2 + sp.sin(theta) ** 2 * w**2) / 2 - 9.81 * sp.cos(theta)
+        varia.lagrangian("spherical-pendulum-angles", L, [theta, phi], [u, w])
+        method = {"construction": "galerkin", "degree": 1, "quadrature": {"type": "gauss-lobatto", "points": 2}}
+        angles = varia.run({"system": {"manifold": {"type": "Rn", "dim": 2}, "lagrangian": {"type": "spherical-pendulum-angles"}},
+                            "method": method, "initial": {"q": [1.0, 0.0], "v": [0.0, 0.3]}, "step": 0.002, "steps": 5000,
+                            "observe": ["energy"]})
+        self.assertEqual(len(angles.record["warnings"]), 1)
+        self.assertIn("the energy departed", angles.record["warnings"][0])
+        rod = varia.run({"system": {"manifold": {"type": "Rn", "dim": 3},
+                                    "lagrangian": {"type": "composite", "space_dim": 3, "masses": [1],
+                                                   "terms": [{"type": "gravity", "g": [0, 0, -9.81]}]},
+                                    "constraints": [{"type": "rod", "anchor": [0, 0, 0], "particle": 0}]},
+                         "method": method, "step": 0.002, "steps": 5000, "observe": ["energy"],
+                         "initial": {"q": [np.sin(1.0), 0.0, np.cos(1.0)], "v": [0.0, 0.3 * np.sin(1.0), 0.0]}})
+        self.assertNotIn("warnings", rod.record)
+        print(f"\nenergy error: in angles {angles.record['energy_error_max']:.3g}, on a rod {rod.record['energy_error_max']:.3g}")
+        self.assertLess(rod.record["energy_error_max"], angles.record["energy_error_max"] / 100)
+
     def test_symbols_that_are_not_q_v_or_parameters_are_refused(self):
         x, v, k = sp.symbols("x v k")
         with self.assertRaises(ValueError):
