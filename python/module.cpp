@@ -38,10 +38,20 @@ namespace {
 struct FailureTag {};
 py::handle failure_type;  // _varia.Failure, set when the module is made
 
-// The bundled plugins: build/lib/varia/plugins from build/python/varia/_varia*.so.
+// Where the module is: build/python/varia in the build tree, <prefix>/lib/python3/dist-packages/varia
+// installed.
+std::filesystem::path here() { return std::filesystem::path(boost::dll::this_line_location().string()).parent_path(); }
+
+// The first of the candidates that exists (else the first).
+std::filesystem::path first_existing(std::vector<std::filesystem::path> candidates) {
+  for (auto& path : candidates)
+    if (std::filesystem::exists(path)) return path.lexically_normal();
+  return candidates.front().lexically_normal();
+}
+
+// The bundled plugins: build/lib/varia/plugins, or <prefix>/lib/varia/plugins installed.
 std::filesystem::path bundled_plugins() {
-  const auto here = std::filesystem::path(boost::dll::this_line_location().string()).parent_path();
-  return (here / ".." / ".." / "lib" / "varia" / "plugins").lexically_normal();
+  return first_existing({here() / ".." / ".." / "lib" / "varia" / "plugins", here() / ".." / ".." / ".." / "varia" / "plugins"});
 }
 
 Registry make_registry() { return Registry(Registry::search_path({}, bundled_plugins())); }
@@ -185,6 +195,21 @@ std::string ld(const std::string& kind, const std::string& value, const std::vec
   });
 }
 
+// The SDK's headers, for varia.lagrangian's compiler: the source tree's (in the build tree), or
+// <prefix>/include installed.
+std::vector<std::string> sdk_include_dirs() {
+  std::vector<std::string> dirs;
+  const std::string all = VARIA_SDK_INCLUDE_DIRS;
+  for (std::size_t start = 0, end; start <= all.size(); start = end + 1) {
+    end = all.find(':', start);
+    if (end == std::string::npos) end = all.size();
+    dirs.push_back(all.substr(start, end - start));
+  }
+  if (std::filesystem::exists(here() / ".." / ".." / "lib" / "varia" / "plugins") && std::filesystem::exists(dirs.front()))
+    return dirs;
+  return {(here() / ".." / ".." / ".." / ".." / "include").lexically_normal().string()};
+}
+
 // `varia cost` on scene files, writing cost.csv, cost.json and cost.svg into `out`.
 void cost(const std::vector<std::string>& files, const std::vector<double>& h, const std::string& out) {
   guarded([&](Registry&) {
@@ -210,14 +235,5 @@ PYBIND11_MODULE(_varia, m) {
   m.def("verify", &varia::host::verify);
   m.def("ld", &varia::host::ld);
   m.def("cost", &varia::host::cost);
-  m.def("sdk_include_dirs", [] {  // the SDK's headers, for varia.lagrangian's compiler
-    std::vector<std::string> dirs;
-    std::string all = VARIA_SDK_INCLUDE_DIRS;
-    for (std::size_t start = 0, end; start <= all.size(); start = end + 1) {
-      end = all.find(':', start);
-      if (end == std::string::npos) end = all.size();
-      dirs.push_back(all.substr(start, end - start));
-    }
-    return dirs;
-  });
+  m.def("sdk_include_dirs", &varia::host::sdk_include_dirs);
 }

@@ -43,4 +43,11 @@ named=$(jq '.plugins_loaded | length' "$work/run.json")
 [ "$named" -ge 1 ] || fail "the run record names no plugin loaded"
 [ "$opened" -eq "$named" ] || fail "the run opened $opened plugin files of $installed for the $named it needs: $(jq -c .plugins_loaded "$work/run.json")"
 [ "$(wc -l <"$work/run.csv")" -eq 202 ] || fail "the trajectory has $(wc -l <"$work/run.csv") lines, not 202"
+# The Python module, installed beside them: it finds the installed plugins and runs the scene.
+PYTHONPATH=$work/prefix/lib/python3/dist-packages /usr/bin/python3 -c "
+import varia
+assert len(varia.plugins()) == $installed, 'the installed module lists another set of plugins'
+assert len(varia.run('$share/scenes/default.json').t) == 201
+" || fail "the installed Python module does not list the installed plugins or run the default scene"
+
 echo "stripped tree: $installed plugins installed and listed, $scenes example scenes valid; the default scene opened $opened ($(jq -c .plugins_loaded "$work/run.json"))"
