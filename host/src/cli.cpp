@@ -115,10 +115,19 @@ CLI::App* subcommand(CLI::App& app, Options& o, const char* name, const char* de
   return sub;
 }
 
-void add_scene(CLI::App* sub, std::string& scene) {
+void add_settings(CLI::App* sub, Options& o) {
+  sub->add_option("--set", o.common.settings,
+                  "replace the value at a JSON pointer of the scene before it is checked, e.g. --set /step=0.05 or "
+                  "--set '/initial/q=[0.5]' (repeatable, applied in order)")
+      ->type_name("POINTER=JSON")
+      ->allow_extra_args(false);
+}
+
+void add_scene(CLI::App* sub, Options& o, std::string& scene) {
   sub->add_option("SCENE", scene, "the scene file (JSON; its schema: scene.schema.json, see varia --help)")
       ->required()
       ->type_name("SCENE.json");
+  add_settings(sub, o);
 }
 
 using Command = std::function<int()>;
@@ -139,7 +148,7 @@ void define_run(CLI::App& app, Options& o, Command& chosen) {
                          "stdout, and the human summary then goes to stderr). A short human summary is "
                          "printed at the end unless --quiet.",
                          "Example:\n  varia run scenes/default.json --out traj.csv --summary run.json");
-  add_scene(run, o.scene);
+  add_scene(run, o, o.scene);
   run->add_option("--out", o.run_out,
                   "write the trajectory here: CSV (t, q0.., p0.., observables), or HDF5 for a name ending in .h5 "
                   "(datasets t, q, p and one per observable; the scene as the root's attribute 'scene')")
@@ -165,7 +174,7 @@ void define_ld(CLI::App& app, Options& o, Command& chosen) {
                         "Evaluate the scene's discrete Lagrangian L_d(q0, q1; h) and its derivatives D1 L_d, "
                         "D2 L_d at one point.",
                         "Example:\n  varia ld scenes/default.json --q0 1.3 --q1 1.25 --h 0.1 --json");
-  add_scene(ld, o.scene);
+  add_scene(ld, o, o.scene);
   ld->add_option("--q0", o.ld.q0, "the first point, comma-separated")->required()->type_name("A,B,..");
   ld->add_option("--q1", o.ld.q1, "the second point, comma-separated")->required()->type_name("C,D,..");
   ld->add_option("--h", o.ld.h, "the step size")->required()->type_name("H");
@@ -178,7 +187,7 @@ void define_validate(CLI::App& app, Options& o, Command& chosen) {
                               "Check a scene against the scene schema and the plugins' parameter schemas, "
                               "and build its integrator, without running it.",
                               "Example:\n  varia validate scenes/default.json");
-  add_scene(validate, o.scene);
+  add_scene(validate, o, o.scene);
   validate->callback([&] { chosen = [&] { return command_validate(o.common, o.scene); }; });
 }
 
@@ -190,7 +199,7 @@ void define_verify(CLI::App& app, Options& o, Command& chosen) {
                             "momentum_conserved, symplectic, energy_bounded. Exit 1 when a predicted property "
                             "does not hold or could not be measured.",
                             "Example:\n  varia verify scenes/default.json --json checks.json");
-  add_scene(verify, o.scene);
+  add_scene(verify, o, o.scene);
   verify->add_option("--json", o.verify_json, "write the checks as JSON here")->type_name("FILE");
   verify->add_flag("--explain", o.verify_explain,
                    "print how each property was predicted and measured (the theorem, the fit, the points dropped "
@@ -214,6 +223,7 @@ void define_cost(CLI::App& app, Options& o, Command& chosen) {
                           "Example:\n  varia cost scenes/pendulum-galerkin-s1.json scenes/pendulum-galerkin-s2.json "
                           "--out cost/");
   cost->add_option("SCENE", o.scenes, "scene files")->required()->type_name("SCENE.json");
+  add_settings(cost, o);
   cost->add_option("--out", o.cost_out, "write cost.csv and cost.svg in this directory")->type_name("DIR");
   cost->add_option("--h", o.cost.h, "the step sizes to run, comma-separated (default: the scene's step times 4, 2, "
                                      "1, 1/2, ..., 1/16)")

@@ -25,10 +25,13 @@ namespace {
 
 Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
 
-// Loads and assembles a scene file; every InputError about it is prefixed with the file's name.
-Prepared prepare(const std::string& scene_file, Registry& registry) {
+// Loads a scene file, applies the --set settings, and assembles it; every InputError about the scene
+// is prefixed with the file's name.
+Prepared prepare(const std::string& scene_file, const CommonOptions& common, Registry& registry) {
   try {
-    return prepare_document(read_json_file(scene_file), registry);
+    json document = read_json_file(scene_file);
+    apply_settings(document, common.settings);
+    return prepare_document(document, registry);
   } catch (const InputError& e) {
     throw InputError(fmt::format("{}: {}", scene_file, e.what()));
   }
@@ -195,7 +198,7 @@ int command_plugins(const CommonOptions& common, bool as_json) {
 
 int command_validate(const CommonOptions& common, const std::string& scene_file) {
   return with_registry(common, [&](Registry& registry) {
-    const Prepared prepared = prepare(scene_file, registry);
+    const Prepared prepared = prepare(scene_file, common, registry);
     fmt::print(results(), "{}: valid ({} with {} on {}, {} steps of {})\n", scene_file, prepared.scene.construction->name(),
                prepared.scene.lagrangian.type, prepared.scene.manifold.type, prepared.scene.steps,
                prepared.scene.step);
@@ -210,7 +213,7 @@ int command_run(const CommonOptions& common, const std::string& scene_file, cons
     if (file) outputs.push_back({flag, *file});
   check_distinct({{"scene", scene_file}}, outputs);
   return with_registry(common, [&](Registry& registry) {
-    Prepared prepared = prepare(scene_file, registry);
+    Prepared prepared = prepare(scene_file, common, registry);
     run_scene(prepared.scene, prepared.assembly, registry, options);
     return 0;
   });
@@ -239,7 +242,7 @@ nlohmann::ordered_json discrete_lagrangian(Prepared& prepared, const LdOptions& 
 
 int command_ld(const CommonOptions& common, const std::string& scene_file, const LdOptions& options) {
   return with_registry(common, [&](Registry& registry) {
-    Prepared prepared = prepare(scene_file, registry);
+    Prepared prepared = prepare(scene_file, common, registry);
     nlohmann::ordered_json result;
     try {
       result = discrete_lagrangian(prepared, options);
@@ -261,7 +264,7 @@ int command_verify(const CommonOptions& common, const std::string& scene_file, c
                    const std::vector<double>& h, bool explain) {
   if (!json_file.empty()) check_distinct({{"scene", scene_file}}, {{"--json", json_file}});
   return with_registry(common, [&](Registry& registry) {
-    Prepared prepared = prepare(scene_file, registry);
+    Prepared prepared = prepare(scene_file, common, registry);
     check_fit_steps(prepared.scene, h);
     const auto checks = verify_scene(prepared.scene, prepared.assembly, registry, h);
     fmt::print(results(), "{}", checks_table(checks, explain));

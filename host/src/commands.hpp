@@ -25,6 +25,7 @@ nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records);
 
 struct CommonOptions {
   std::vector<std::string> plugin_paths;  // --plugin-path, repeatable
+  std::vector<std::string> settings;      // --set POINTER=JSON, repeatable (scene.hpp, apply_settings)
 };
 
 // Runs a command's body with a registry of its own. A plugin fault, or a non-finite value that a

@@ -163,12 +163,12 @@ std::string method_name(const std::string& file) {
   return std::filesystem::path(file).stem().string();
 }
 
-void load_method(const std::string& file, Registry& registry, std::deque<Method>& methods) {
+void load_method(const std::string& file, const CommonOptions& common, Registry& registry, std::deque<Method>& methods) {
   Method& m = methods.emplace_back();
   m.file = file;
   try {
     m.name = method_name(file);
-    m.scene = load_scene(file, registry);
+    m.scene = load_scene(file, registry, common.settings);
     m.scene.observe = Observe::energy_only();  // the energy error is always measured
     m.assembly = assemble(m.scene, registry);
     // The order the theorems give for the parts that assemble() recorded (verification.hpp).
@@ -340,7 +340,7 @@ int command_cost(const CommonOptions& common, const std::vector<std::string>& sc
   check_cost_outputs(scene_files, options.out);
   return with_registry(common, [&](Registry& registry) {
     std::deque<Method> methods;  // a deque: an Assembly stays where it was built
-    for (const auto& file : scene_files) load_method(file, registry, methods);
+    for (const auto& file : scene_files) load_method(file, common, registry, methods);
     for (const Method& m : methods) check_step_sizes(m, options.h);
 
     std::map<std::string, Truth> truths;

@@ -8,6 +8,7 @@
 
 #include "json_reader.hpp"
 #include "json_schema.hpp"
+#include "output.hpp"
 #include "registry.hpp"
 #include "scene_schema.hpp"
 
@@ -194,8 +195,31 @@ void validate_parameters(Scene& scene, Registry& registry) {
   for (PluginSpec* spec : scene.plugins()) validate_spec(*spec, registry);
 }
 
-Scene load_scene(const std::filesystem::path& file, Registry& registry) {
-  Scene scene = parse_scene(read_json_file(file));
+void apply_settings(json& document, const std::vector<std::string>& settings) {
+  for (const std::string& setting : settings) {
+    const auto equals = setting.find('=');
+    if (equals == std::string::npos || equals == 0 || setting[0] != '/')
+      throw InputError(fmt::format("--set: expected POINTER=JSON (a JSON pointer such as /step, then '=', then a JSON "
+                                   "value); found '{}'",
+                                   printable(setting)));
+    json value;
+    try {
+      value = parse_json_text(setting.substr(equals + 1));
+    } catch (const InputError& e) {
+      throw InputError(fmt::format("--set {}: the value is not JSON: {}", printable(setting.substr(0, equals)), e.what()));
+    }
+    try {
+      document[json::json_pointer(setting.substr(0, equals))] = std::move(value);
+    } catch (const json::exception& e) {
+      throw InputError(fmt::format("--set {}: not a place in the scene: {}", printable(setting.substr(0, equals)), e.what()));
+    }
+  }
+}
+
+Scene load_scene(const std::filesystem::path& file, Registry& registry, const std::vector<std::string>& settings) {
+  json document = read_json_file(file);
+  apply_settings(document, settings);
+  Scene scene = parse_scene(document);
   validate_parameters(scene, registry);
   return scene;
 }

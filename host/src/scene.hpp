@@ -73,8 +73,11 @@ Scene parse_scene(const nlohmann::json& document);
 // parts among them (PluginSpec::parts), checked the same way; an unknown type is an InputError
 // naming the object's "type" pointer.
 void validate_parameters(Scene& scene, Registry& registry);
-// read_json_file + parse_scene + validate_parameters.
-Scene load_scene(const std::filesystem::path& file, Registry& registry);
+// Spec "--set POINTER=JSON": replaces (or adds) the value at each JSON pointer of the document, in
+// order, before the scene is checked; InputError at "--set" for a setting that is not POINTER=JSON.
+void apply_settings(nlohmann::json& document, const std::vector<std::string>& settings);
+// read_json_file + apply_settings + parse_scene + validate_parameters.
+Scene load_scene(const std::filesystem::path& file, Registry& registry, const std::vector<std::string>& settings = {});
 // Checks initial.q/p/v against the manifold (sizes, contains); InputError naming /initial/...
 void check_initial_state(const Scene& scene, Manifold& manifold, const std::string& manifold_type);
 

@@ -302,5 +302,27 @@ TEST_CASE("a run whose energy departs from its start by more than departure_warn
   CHECK(fine.err.empty());
 }
 
+// Issue #42 item 3: --set POINTER=JSON on every command that reads a scene, applied before the
+// scene is checked.
+TEST_CASE("--set replaces values at JSON pointers before the scene is checked, and a bad one exits 2 naming --set") {
+  TempDir dir;
+  const auto run = run_varia("run scenes/default.json --quiet --set /step=0.05 --set '/initial/q=[0.5]' --out '" +
+                             (dir / "t.csv").string() + "'");
+  REQUIRE(run.code == 0);
+  const auto lines = lines_of(read_file(dir / "t.csv"));
+  CHECK(lines.size() == 402);  // t_end 20 at h = 0.05: 400 steps, 401 rows and the header
+  CHECK(lines[1].rfind("0,0.5,", 0) == 0);
+  CHECK(run_varia("validate scenes/default.json --set /step=-1").err.find("/step: expected a number > 0") !=
+        std::string::npos);
+  for (const char* bad : {"--set step=1", "--set /step=abc", "--set '/a~2=1'"}) {
+    CAPTURE(bad);
+    const auto refused = run_varia(std::string("validate scenes/default.json ") + bad);
+    CHECK(refused.code == 2);
+    CHECK(contains(refused.err, "--set"));
+  }
+  CHECK(run_varia("verify scenes/default.json --set /step=0.2 --h 0.4,0.2,0.1,0.05").code == 0);
+  CHECK(run_varia("cost scenes/default.json --set /step=0.2 --quiet --h 0.2,0.1,0.05,0.025 --out '" + dir.path().string() + "'").code == 0);
+}
+
 }  // namespace
 }  // namespace varia::test
