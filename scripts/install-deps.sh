@@ -8,7 +8,7 @@ packages=(
   libvalijson-dev gnuplot-nox libhdf5-dev
   clang libclang-rt-14-dev  # the scene fuzzer (ctest -L fuzz): libFuzzer
   gfortran  # bench_gni: the GNI peer (../shared/peers/gni) it times varia against
-  pybind11-dev python3-dev python3-numpy python3-sympy  # the Python module (docs/python.md), for /usr/bin/python3
+  pybind11-dev python3-dev python3-numpy python3-sympy python3-matplotlib  # the Python module (docs/python.md), for /usr/bin/python3
 )
 missing=()
 for p in "${packages[@]}"; do

@@ -257,14 +257,20 @@ void write_csv(const std::filesystem::path& file, const std::deque<Method>& meth
   write_output(file, text, "--out");
 }
 
+// The method's line of cost.json: its prediction and fit, and its rows (cost.csv's, at full precision).
 json method_record(const Method& m) {
+  json rows = json::array();
+  for (const Row& r : m.rows)
+    rows.push_back({{"h", r.h}, {"steps", r.steps}, {"error", r.error}, {"energy_error", r.energy_error},
+                    {"seconds", r.seconds}, {"newton_iterations", r.newton_iterations}, {"evaluations", r.evaluations}});
   return {{"method", m.name},
           {"scene", m.file},
           {"predicted_order", m.predicted_order},
           {"fitted_slope", m.fit.fitted() ? json(m.fit.slope) : json(nullptr)},
           {"points_fitted", m.fit.used},
           {"points_dropped", m.fit.dropped},
-          {"reference", m.truth->source}};
+          {"reference", m.truth->source},
+          {"rows", rows}};
 }
 
 // The predicted slope, drawn through the method's smallest-h point that the fit kept.
