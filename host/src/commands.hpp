@@ -24,8 +24,8 @@ Prepared prepare_document(const nlohmann::json& document, Registry& registry);
 nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records);
 
 struct CommonOptions {
-  std::vector<std::string> plugin_paths;  // --plugin-path, repeatable
-  std::vector<std::string> settings;      // --set POINTER=JSON, repeatable (scene.hpp, apply_settings)
+  std::vector<std::string> plugin_paths{};  // --plugin-path, repeatable
+  std::vector<std::string> settings{};      // --set POINTER=JSON, repeatable (scene.hpp, apply_settings)
 };
 
 // Runs a command's body with a registry of its own. A plugin fault, or a non-finite value that a
