@@ -133,7 +133,8 @@ void GalerkinDiscreteLagrangian::constrained_newton(double h, int first_unknown,
 }
 
 // The stored entries of the constant mass matrix: a dense Lagrangian's constant_mass_matrix, a
-// sparse one's Hessian's velocity block at q (constant, so any point gives it).
+// sparse one's Hessian's velocity block at q (constant, so any point gives it). The projection's M
+// here, and the sparse explicit form's (galerkin_explicit.cpp, factorize_sparse_mass).
 std::vector<Eigen::Triplet<double>> GalerkinDiscreteLagrangian::mass_entries(const double* q) {
   std::vector<Eigen::Triplet<double>> mass;
   if (lagrangian_.sparse()) {

@@ -178,10 +178,7 @@ void GalerkinDiscreteLagrangian::keep_explicit_state(const double* q, const doub
 }
 
 void GalerkinDiscreteLagrangian::factorize_sparse_mass(const double* q) {
-  lagrangian_.sparse_hessian(q, v_.data(), grad_.data(), sparse_values_.data());
-  std::vector<Eigen::Triplet<double>> triplets;
-  for (int e = 0; e < lagrangian_.pattern_size(); ++e)
-    if (entries_[e].row_v && entries_[e].col_v) triplets.emplace_back(entries_[e].row, entries_[e].col, sparse_values_[e]);
+  const std::vector<Eigen::Triplet<double>> triplets = mass_entries(q);
   sparse_mass_.resize(n_, n_);
   sparse_mass_.setFromTriplets(triplets.begin(), triplets.end());
   sparse_mass_solver_.compute(sparse_mass_);
