@@ -240,7 +240,8 @@ void GalerkinDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
   }
   const bool continues = same_point && previous_h_ == h;
   // impulse_ is then p1 - p0, q^s - q^0 that of q1 (solve_at_nodes, or the Equations' finish())
-  if (!(node_iteration_ && solve_at_nodes<N, R>(p0, h, continues))) {
+  step_at_nodes_ = node_iteration_ && solve_at_nodes<N, R>(p0, h, continues);
+  if (!step_at_nodes_) {
     warm_start(q0, p0, h, continues);
     newton(h, 1, 0, s_, p0, !forces_.empty());
     if (constraints_ != nullptr) project_momentum(p0);
@@ -264,6 +265,16 @@ void GalerkinDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
     previous_ = points_;
   previous_h_ = h;
   has_previous_ = true;
+}
+
+void GalerkinDiscreteLagrangian::control_points_of_step(const double* q0, const double* q1, double h) {
+  origin_ = Eigen::Map<const Eigen::VectorXd>(q0, n_);
+  points_.col(0).setZero();
+  if (explicit_advance_ != nullptr)  // degree 1: the control points are the end points
+    points_.col(1) = Eigen::Map<const Eigen::VectorXd>(q1, n_) - origin_;
+  else if (step_at_nodes_)  // q^1..q^s from the converged forces, as solve_at_nodes formed q^s
+    offsets_from_forces<Eigen::Dynamic, Eigen::Dynamic, Eigen::Dynamic>(control_map_, h, node_accelerations_.data(),
+                                                                        points_.col(1).data());
 }
 
 GalerkinDiscreteLagrangian::StepFunction GalerkinDiscreteLagrangian::step_function(int n, int nodes,

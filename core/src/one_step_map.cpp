@@ -28,7 +28,8 @@ OneStepHamiltonianMap::OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lag
       tangent_(!manifold.is_vector_space()),
       options_(options),
       y0_(Eigen::VectorXd::Zero(m_ + n_)),
-      y1_(Eigen::VectorXd::Zero(m_ + n_)) {
+      y1_(Eigen::VectorXd::Zero(m_ + n_)),
+      deviation_w_(n_) {
   method_.set_solver(options.tolerance, options.max_iterations);
 }
 
@@ -48,6 +49,46 @@ void OneStepHamiltonianMap::take_step(const double* q0, const double* p0, double
   if (field_->constant_mass()) Eigen::Map<Eigen::VectorXd>(p1, n_).noalias() = field_->mass() * y1_.tail(n_);
   else if (tangent_) lagrangian_.legendre(q1, y1_.data() + m_, p1);
   else Eigen::Map<Eigen::VectorXd>(p1, n_) = y1_.tail(n_);
+}
+
+std::string OneStepHamiltonianMap::tangent_map_refusal() const {
+  if (tangent_) return "the one-step construction's tangent map is derived on vector spaces only yet";
+  if (!lagrangian_.plugin().evaluates_at_jets())
+    return "the one-step construction's tangent map steps jets, and this Lagrangian does not evaluate at jets";
+  return {};
+}
+
+// y = (q, w) with w = M^{-1} p (a constant mass matrix) or p (mechanical_field.hpp): the directions
+// in y are (dq, M^{-1} dp) or (dq, dp), and the images' dp1 = M dw1 or dw1.
+void OneStepHamiltonianMap::take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1,
+                                              double* p1, int count, const double* directions, double* images) {
+  if (const std::string refusal = tangent_map_refusal(); !refusal.empty()) throw std::logic_error(refusal);
+  take_step(q0, p0, t0, h, q1, p1);
+  const int size = m_ + n_, capacity = field_->jet_variables();
+  jets0_.resize(size);
+  jets1_.resize(size);
+  Eigen::VectorXd& w = deviation_w_;
+  for (int first = 0; first < count; first += capacity) {
+    const int k = std::min(capacity, count - first);
+    for (int r = 0; r < size; ++r) {
+      jets0_[r] = Jet2::variable(y0_[r], k, 0);
+      jets0_[r].gradient.setZero();
+    }
+    for (int j = 0; j < k; ++j) {
+      const double* dx = directions + static_cast<std::ptrdiff_t>(first + j) * size;
+      if (field_->constant_mass()) field_->inverse_mass(dx + m_, w.data());
+      else w = Eigen::Map<const Eigen::VectorXd>(dx + m_, n_);
+      for (int r = 0; r < size; ++r) jets0_[r].gradient[j] = r < m_ ? dx[r] : w[r - m_];
+    }
+    field_->step(method_, h, jets0_.data(), jets1_.data(), tangent_stages_);
+    for (int j = 0; j < k; ++j) {
+      double* image = images + static_cast<std::ptrdiff_t>(first + j) * size;
+      for (int r = 0; r < size; ++r) image[r] = jets1_[r].constant() ? 0.0 : jets1_[r].gradient[j];
+      if (!field_->constant_mass()) continue;
+      w = Eigen::Map<const Eigen::VectorXd>(image + m_, n_);
+      Eigen::Map<Eigen::VectorXd>(image + m_, n_).noalias() = field_->mass() * w;
+    }
+  }
 }
 
 }  // namespace varia

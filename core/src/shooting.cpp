@@ -387,7 +387,7 @@ void ShootingDiscreteLagrangian::gather(const Pass& pass) {
 void ShootingDiscreteLagrangian::second_derivatives(const Pass& pass) {
   const int k = static_cast<int>(pass.variables.size());
   for (int j = 0; j < k; ++j) {
-    if (pass.variables[j] < n_) continue;
+    if (pass.variables[j] < n_ && !all_second_derivatives_) continue;
     for (int i = 0; i < k; ++i) {
       double phi = second(generating_, i, j) + work_jacobian_(i, j);
       for (int r = 0; r < n_; ++r) phi -= lambda_[r] * second(boundary_[r], i, j);

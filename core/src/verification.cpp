@@ -6,6 +6,7 @@
 #include <Eigen/QR>
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -416,7 +417,10 @@ Eigen::MatrixXd directional(CanonicalChart& chart, const double* p0, int n, doub
 // (S D N)^T J (S D N)|, N = diag(1 / |S d_j|). With D the coordinate directions it is
 // ||(S M S^-1)^T J (S M S^-1) - J||max, zero exactly when M is symplectic; with D a basis of the
 // tangent space of a submanifold, zero exactly when M preserves the form restricted to it.
-double defect(const Eigen::MatrixXd& images, const Eigen::MatrixXd& directions, const Eigen::VectorXd& a) {
+// `scale` (if not null): the largest entry of the rescaled (S M D N)^T J (S M D N), the size of the
+// terms the defect is a difference of.
+double defect(const Eigen::MatrixXd& images, const Eigen::MatrixXd& directions, const Eigen::VectorXd& a,
+              double* scale = nullptr) {
   const int n = static_cast<int>(images.rows()) / 2;
   Eigen::VectorXd s(2 * n);
   s << a.cwiseInverse(), a;
@@ -429,10 +433,30 @@ double defect(const Eigen::MatrixXd& images, const Eigen::MatrixXd& directions, 
   Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2 * n, 2 * n);
   J.topRightCorner(n, n).setIdentity();
   J.bottomLeftCorner(n, n) = -Eigen::MatrixXd::Identity(n, n);
-  return (out.transpose() * J * out - in.transpose() * J * in).cwiseAbs().maxCoeff();
+  const Eigen::MatrixXd form = out.transpose() * J * out;
+  if (scale != nullptr) *scale = form.cwiseAbs().maxCoeff();
+  return (form - in.transpose() * J * in).cwiseAbs().maxCoeff();
 }
 
 }  // namespace
+
+SymplecticityDefect exact_symplecticity_defect(DiscreteHamiltonianMap& map, const double* q0, const double* p0,
+                                               double t0, double h, const Eigen::VectorXd& steps, double tolerance) {
+  const int n = map.dim();
+  const Eigen::VectorXd a = (steps.head(n).array() / steps.tail(n).array()).sqrt();
+  const Eigen::MatrixXd directions = steps.asDiagonal();
+  Eigen::MatrixXd images(2 * n, 2 * n);
+  Eigen::VectorXd q1(map.point_size()), p1(n);
+  map.step_with_tangent(q0, p0, t0, h, q1.data(), p1.data(), 2 * n, directions.data(), images.data());
+  double scale = 0.0;
+  const double value = defect(images, directions, a, &scale);
+  constexpr double eps = std::numeric_limits<double>::epsilon();
+  return {value, (2 * n * eps + tolerance) * std::max(1.0, scale)};
+}
+
+double symplecticity_residual(const Eigen::MatrixXd& M) {
+  return defect(M, Eigen::MatrixXd::Identity(M.rows(), M.cols()), Eigen::VectorXd::Ones(M.rows() / 2));
+}
 
 SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& manifold,
                                          const double* q0, const double* p0, double h,

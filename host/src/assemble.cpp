@@ -134,6 +134,15 @@ void check_observables(const Scene& scene, Lagrangian& lagrangian, const Manifol
         scene.manifold.type));
 }
 
+// Spec "Tangent maps and ensembles": megno and lyapunov propagate a deviation by the map's tangent map.
+void check_tangent_map(const Scene& scene, const DiscreteHamiltonianMap& map) {
+  if (!scene.observe.chaos()) return;
+  if (const std::string refusal = map.tangent_map_refusal(); !refusal.empty())
+    throw InputError(fmt::format("/observe: expected no \"{}\": it propagates a deviation by the step's tangent map, "
+                                 "and {}",
+                                 scene.observe.megno ? "megno" : "lyapunov", refusal));
+}
+
 Eigen::VectorXd to_vector(const std::vector<double>& values) {
   return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
 }
@@ -219,6 +228,7 @@ Assembly assemble(const Scene& scene, Registry& registry) {
   create_forces(scene, registry, a);
   create_constraints(scene, registry, a);
   scene.construction->build(scene, registry, a);
+  check_tangent_map(scene, *a.map);
   initial_state(scene, a);
   check_initial_constraints(scene, a);
   return a;

@@ -97,6 +97,7 @@ struct Options {
   RunOptions run;
   std::string run_out, run_summary, run_plot;
   LdOptions ld;
+  TangentOptions tangent;
   bool json = false;
   std::string verify_json, cost_out;
   std::vector<double> verify_h;
@@ -182,6 +183,21 @@ void define_ld(CLI::App& app, Options& o, Command& chosen) {
   ld->callback([&] { chosen = [&] { return command_ld(o.common, o.scene, o.ld); }; });
 }
 
+void define_tangent(CLI::App& app, Options& o, Command& chosen) {
+  auto* tangent = subcommand(
+      app, o, "tangent",
+      "Take one step of the scene's discrete Hamiltonian map from (q0, p0) and print its tangent map "
+      "d(q1, p1)/d(q0, p0), exact (the implicit function theorem on the step's own equations), rows q1 then p1, "
+      "with its symplecticity defect.",
+      "Example:\n  varia tangent scenes/default.json --q0 1.3 --p0 0.2 --h 0.1 --json");
+  add_scene(tangent, o, o.scene);
+  tangent->add_option("--q0", o.tangent.q0, "the point, comma-separated")->required()->type_name("A,B,..");
+  tangent->add_option("--p0", o.tangent.p0, "the momentum, comma-separated")->required()->type_name("C,D,..");
+  tangent->add_option("--h", o.tangent.h, "the step size")->required()->type_name("H");
+  tangent->add_flag("--json", o.tangent.json, "print {\"q1\": [...], \"p1\": [...], \"jacobian\": [[...], ...]}");
+  tangent->callback([&] { chosen = [&] { return command_tangent(o.common, o.scene, o.tangent); }; });
+}
+
 void define_validate(CLI::App& app, Options& o, Command& chosen) {
   auto* validate = subcommand(app, o, "validate",
                               "Check a scene against the scene schema and the plugins' parameter schemas, "
@@ -241,6 +257,7 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
   define_plugins(app, o, chosen);
   define_run(app, o, chosen);
   define_ld(app, o, chosen);
+  define_tangent(app, o, chosen);
   define_validate(app, o, chosen);
   define_verify(app, o, chosen);
   define_cost(app, o, chosen);

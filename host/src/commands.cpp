@@ -260,6 +260,57 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
   });
 }
 
+nlohmann::ordered_json tangent_map(Prepared& prepared, const TangentOptions& options) {
+  Assembly& a = prepared.assembly;
+  if (const std::string refusal = a.map->tangent_map_refusal(); !refusal.empty())
+    throw InputError(fmt::format("/method/construction: expected a construction with a tangent map: {}", refusal));
+  if (!(options.h > 0.0) || !std::isfinite(options.h))
+    throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
+  const Eigen::VectorXd q0 = parse_point(options.q0, *a.manifold, prepared.scene.manifold.type, "--q0");
+  const Eigen::VectorXd p0 = parse_numbers(options.p0, a.map->dim(), "--p0");
+  const int d = 2 * a.map->dim();
+  Eigen::VectorXd q1(a.map->point_size()), p1(a.map->dim());
+  const Eigen::MatrixXd directions = Eigen::MatrixXd::Identity(d, d);
+  Eigen::MatrixXd jacobian(d, d);
+  a.map->step_with_tangent(q0.data(), p0.data(), a.t0, options.h, q1.data(), p1.data(), d, directions.data(),
+                           jacobian.data());
+  if (!q1.allFinite() || !p1.allFinite() || !jacobian.allFinite())
+    throw NumericalFailure(fmt::format("a non-finite step or tangent map from --q0 {} --p0 {} with --h {}", options.q0,
+                                       options.p0, options.h),
+                           std::nan(""));
+  auto rows = nlohmann::ordered_json::array();
+  for (int r = 0; r < d; ++r) rows.push_back(as_vector(jacobian.row(r).transpose()));
+  return nlohmann::ordered_json{{"q1", as_vector(q1)}, {"p1", as_vector(p1)}, {"jacobian", rows}};
+}
+
+int command_tangent(const CommonOptions& common, const std::string& scene_file, const TangentOptions& options) {
+  return with_registry(common, [&](Registry& registry) {
+    Prepared prepared = prepare(scene_file, common, registry);
+    nlohmann::ordered_json result;
+    try {
+      result = tangent_map(prepared, options);
+    } catch (const InputError& e) {
+      if (e.what()[0] != '/') throw;
+      throw InputError(fmt::format("{}: {}", scene_file, e.what()));
+    }
+    if (options.json) {
+      fmt::print(results(), "{}\n", result.dump());
+      return 0;
+    }
+    fmt::print(results(), "q1 = [{}]\np1 = [{}]\nd(q1, p1)/d(q0, p0) =\n", fmt::join(result["q1"].get<std::vector<double>>(), ", "),
+               fmt::join(result["p1"].get<std::vector<double>>(), ", "));
+    const int d = static_cast<int>(result["jacobian"].size());
+    Eigen::MatrixXd M(d, d);
+    for (int r = 0; r < d; ++r) {
+      const auto row = result["jacobian"][r].get<std::vector<double>>();
+      fmt::print(results(), "  {:>24.16e}\n", fmt::join(row, " "));
+      for (int c = 0; c < d; ++c) M(r, c) = row[c];
+    }
+    fmt::print(results(), "symplecticity defect max |M^T J M - J| = {:.3e}\n", symplecticity_residual(M));
+    return 0;
+  });
+}
+
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,
                    const std::vector<double>& h, bool explain) {
   if (!json_file.empty()) check_distinct({{"scene", scene_file}}, {{"--json", json_file}});

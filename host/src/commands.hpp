@@ -53,6 +53,15 @@ int command_ld(const CommonOptions& common, const std::string& scene_file, const
 // {"Ld", "D1", "D2"} at the points and step of `options` (InputError at --q0, --q1, --h or
 // /method/construction; NumericalFailure for a non-finite value).
 nlohmann::ordered_json discrete_lagrangian(Prepared& prepared, const LdOptions& options);
+struct TangentOptions {
+  std::string q0, p0;  // comma-separated numbers
+  double h = 0.0;
+  bool json = false;
+};
+int command_tangent(const CommonOptions& common, const std::string& scene_file, const TangentOptions& options);
+// {"q1", "p1", "jacobian"} (rows: q1 then p1) of one step from the point of `options` (InputError at
+// --q0, --p0, --h or /method/construction; NumericalFailure where the step fails).
+nlohmann::ordered_json tangent_map(Prepared& prepared, const TangentOptions& options);
 // Prints the table of checks (and writes them as JSON when json_file is not empty); 1 when a
 // property the theorems predict was measured not to hold.
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,

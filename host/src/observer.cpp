@@ -9,10 +9,12 @@
 namespace varia::host {
 
 Observer::Observer(const Observe& observe, const Manifold& manifold, Lagrangian& lagrangian,
-                   const Eigen::VectorXd& v0, const SolverOptions& options, HolonomicConstraints* constraints)
+                   const Eigen::VectorXd& v0, const SolverOptions& options, HolonomicConstraints* constraints,
+                   const ChaosIndicators* chaos)
     : what_(observe), manifold_(manifold), lagrangian_(lagrangian), evaluator_(lagrangian), options_(options),
       v_(v0.size() == lagrangian.velocity_size() ? v0 : Eigen::VectorXd::Zero(lagrangian.velocity_size())),
-      constraints_(constraints) {
+      constraints_(constraints),
+      chaos_(chaos) {
   if (what_.momentum) momentum_size_ = lagrangian.momentum_size();
 }
 
@@ -23,6 +25,8 @@ std::vector<std::string> Observer::columns() const {
   if (what_.orthogonality) names.emplace_back("orthogonality");
   if (what_.constraint) names.emplace_back("constraint");
   if (what_.constraint_velocity) names.emplace_back("constraint_velocity");
+  if (what_.megno) names.emplace_back("megno");
+  if (what_.lyapunov) names.emplace_back("lyapunov");
   return names;
 }
 
@@ -42,6 +46,8 @@ void Observer::observe(const double* q, const double* p) {
   if (what_.orthogonality) values_.push_back(manifold_.constraint_error(q));  // ||I - R^T R||_F on SO3 and SE3
   if (what_.constraint) values_.push_back(constraints_->residual(q));
   if (what_.constraint_velocity) values_.push_back(constraints_->velocity_residual(q, v_.data()));
+  if (what_.megno) values_.push_back(chaos_->megno());
+  if (what_.lyapunov) values_.push_back(chaos_->lyapunov());
   if (initial_.empty()) set_scales(q, p);
   update_errors();
 }

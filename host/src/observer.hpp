@@ -1,6 +1,7 @@
 // The observables a scene asks for (spec: "observe"): energy E = <p, v> - L with v from the
 // inverse Legendre transform, the Noether momentum J(q, v), ||I - R^T R|| on SO3, and the
-// constraints' residuals max |g_i(q)| and max |(G(q) v)_i|. Nothing that is not asked for is computed.
+// constraints' residuals max |g_i(q)| and max |(G(q) v)_i|, MEGNO and the largest Lyapunov
+// exponent's estimate (from the trajectory's chaos indicators). Nothing that is not asked for is computed.
 #pragma once
 
 #include <Eigen/Core>
@@ -10,6 +11,7 @@
 #include "scene.hpp"
 #include "varia/abi/lagrangian.hpp"
 #include "varia/abi/manifold.hpp"
+#include "varia/core/chaos_indicators.hpp"
 #include "varia/core/constraints.hpp"
 #include "varia/core/mechanics.hpp"
 
@@ -21,8 +23,10 @@ class Observer {
   // it is not given: the assembly forms v0 only where the scene observes the energy or momentum).
   // constraints: the system's (null without; needed for the constraint observables).
   Observer(const Observe& observe, const Manifold& manifold, Lagrangian& lagrangian, const Eigen::VectorXd& v0,
-           const SolverOptions& options, HolonomicConstraints* constraints = nullptr);
-  // energy; momentum0..; orthogonality; constraint; constraint_velocity
+           const SolverOptions& options, HolonomicConstraints* constraints = nullptr,
+           const ChaosIndicators* chaos = nullptr);
+  // energy; momentum0..; orthogonality; constraint; constraint_velocity; megno; lyapunov
+  // (chaos: the run's indicators, read at every observe(); needed for the last two)
   std::vector<std::string> columns() const;
   // Computes the observables at (q, p) into values() and updates the largest deviations from the
   // first values seen.
@@ -38,6 +42,7 @@ class Observer {
   double energy_scale() const { return energy_scale_; }
   double momentum_scale() const { return momentum_scale_; }
   double constraint_velocity_error() const { return constraint_velocity_error_; }
+  const ChaosIndicators* chaos() const { return chaos_; }
 
   // The sane-range check of a run without forces: the flow conserves the energy and a variational
   // integrator keeps its error bounded (O(h^r) by backward error analysis), so an error beyond the
@@ -62,6 +67,7 @@ class Observer {
   double energy_error_ = 0.0, momentum_error_ = 0.0, orthogonality_error_ = 0.0;
   HolonomicConstraints* constraints_;
   double constraint_error_ = 0.0, constraint_velocity_error_ = 0.0;
+  const ChaosIndicators* chaos_;
   double energy_scale_ = 0.0, momentum_scale_ = 1.0;
   double range_energy_ = 0.0, range_scale_ = -1.0;  // E and |<p, v>| + |L| at the first range check
 };

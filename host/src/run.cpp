@@ -92,6 +92,8 @@ json run_record(const Scene& scene, const Assembly& a, const Observer& observer,
   if (scene.observe.orthogonality) record["orthogonality_error_max"] = observer.orthogonality_error();
   if (scene.observe.constraint) record["constraint_error_max"] = observer.constraint_error();
   if (scene.observe.constraint_velocity) record["constraint_velocity_error_max"] = observer.constraint_velocity_error();
+  if (scene.observe.megno) record["megno_final"] = state.chaos().megno();
+  if (scene.observe.lyapunov) record["lyapunov_final"] = state.chaos().lyapunov();
   record["plugins_loaded"] = registry.loaded();
   return record;
 }
@@ -110,6 +112,8 @@ void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, c
   if (scene.observe.constraint) fmt::print(to, "constraint max    {:.3e}\n", observer.constraint_error());
   if (scene.observe.constraint_velocity)
     fmt::print(to, "constraint velocity max {:.3e}\n", observer.constraint_velocity_error());
+  if (scene.observe.megno) fmt::print(to, "MEGNO             {:.4f}\n", state.chaos().megno());
+  if (scene.observe.lyapunov) fmt::print(to, "Lyapunov exponent {:.4e}\n", state.chaos().lyapunov());
   fmt::print(to, "Newton iterations mean {:.2f}, max {}\n", statistics.mean(), statistics.max_iterations);
   fmt::print(to, "wall time         {:.4f} s\n", outcome.wall_seconds);
 }
@@ -232,8 +236,11 @@ class Stepper {
   Stepper(const Scene& scene, Assembly& a, const RunOptions& options)
       : scene_(scene),
         a_(a),
-        observer_(scene.observe, *a.manifold, *a.lagrangian, a.v0, scene.solver, a.holonomic.get()),
-        trajectory_(*a.map, a.q0, a.p0, a.t0, scene.step) {
+        trajectory_(*a.map, a.q0, a.p0, a.t0, scene.step),
+        observer_(scene.observe, *a.manifold, *a.lagrangian, a.v0, scene.solver, a.holonomic.get(),
+                  &trajectory_.chaos()) {
+    // megno and lyapunov: the deviation starts as the unit vector of equal components in (q, p)
+    if (scene.observe.chaos()) trajectory_.track_deviation(Eigen::VectorXd::Ones(2 * a.map->dim()));
     if (options.out && options.out->extension() == ".h5")
       h5_ = std::make_unique<Hdf5Writer>(*options.out, scene.text);
     else if (options.out)
@@ -334,11 +341,11 @@ class Stepper {
 
   const Scene& scene_;
   Assembly& a_;
-  Observer observer_;
   Trajectory trajectory_;
+  Observer observer_;
   RunOutcome outcome_;
   const bool observing_ = scene_.observe.energy || scene_.observe.momentum || scene_.observe.orthogonality ||
-                          scene_.observe.constraint || scene_.observe.constraint_velocity;
+                          scene_.observe.constraint || scene_.observe.constraint_velocity || scene_.observe.chaos();
   std::unique_ptr<CsvWriter> csv_;
   std::unique_ptr<Hdf5Writer> h5_;
   std::unique_ptr<PlotRecorder> plot_;

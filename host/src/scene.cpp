@@ -92,6 +92,8 @@ void read_observe(const json& document, Scene& scene) {
     if (name == "orthogonality") scene.observe.orthogonality = true;
     if (name == "constraint") scene.observe.constraint = true;
     if (name == "constraint_velocity") scene.observe.constraint_velocity = true;
+    if (name == "megno") scene.observe.megno = true;
+    if (name == "lyapunov") scene.observe.lyapunov = true;
   }
 }
 

@@ -35,6 +35,8 @@ std::string manifold_name(const PluginSpec& manifold);
 
 struct Observe {
   bool energy = false, momentum = false, orthogonality = false, constraint = false, constraint_velocity = false;
+  bool megno = false, lyapunov = false;  // from the tangent map along the run
+  bool chaos() const { return megno || lyapunov; }
   static Observe energy_only() {
     Observe o;
     o.energy = true;

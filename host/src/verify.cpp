@@ -245,24 +245,33 @@ Eigen::MatrixXd tangent_directions(VerifiedScene& x, const Eigen::VectorXd& step
                                    1e-3 * (speed > 0.0 ? speed : 1.0));
 }
 
+// Where the map has its exact tangent map (and no constraints: the form is then restricted to the
+// constraint's tangent space, whose basis the differences take), M is the tangent map itself.
 PropertyCheck symplectic(VerifiedScene& x) {
   const Eigen::VectorXd steps = difference_steps(x);
   const Eigen::MatrixXd tangent = tangent_directions(x, steps);
+  const bool exact = !x.a.holonomic && x.a.map->tangent_map_refusal().empty();
   const auto d = defect_values("symplectic", steps_of(x, {1, 0, -1}), kNoiseSpread * kEpsilon, [&](double h, double& noise) {
     const auto defect =
-        symplecticity_defect(*x.a.map, *x.a.manifold, x.a.q0.data(), x.a.p0.data(), h, steps, tangent);
+        exact ? exact_symplecticity_defect(*x.a.map, x.a.q0.data(), x.a.p0.data(), x.a.t0, h, steps,
+                                           x.scene.solver.tolerance)
+              : symplecticity_defect(*x.a.map, *x.a.manifold, x.a.q0.data(), x.a.p0.data(), h, steps, tangent);
     noise = std::max(noise, 10 * defect.noise);
     return defect.defect;
   });
-  return defect_check("symplectic", prediction(x.predictions.symplectic), d,
-                      std::string(x.a.holonomic ? "on the constraint's cotangent bundle {g = 0, G M^-1 p = 0}: "
-                                                  "max |omega(M u, M w) - omega(u, w)| over a basis of its tangent "
-                                                  "space, "
-                                                  : "||M^T J M - J||max ") +
-                          "in canonical chart coordinates, each in its own scale (positions in the "
-                          "state's length, momenta in mass times its speed), M by Richardson-extrapolated central "
-                          "differences of a thousandth of those scales (noise: 10 times their change with the "
-                          "difference step)");
+  const std::string form = x.a.holonomic ? "on the constraint's cotangent bundle {g = 0, G M^-1 p = 0}: max |omega(M u, "
+                                           "M w) - omega(u, w)| over a basis of its tangent space, "
+                                         : "||M^T J M - J||max ";
+  const std::string scales =
+      "in canonical chart coordinates, each in its own scale (positions in the state's length, momenta in mass times "
+      "its speed), ";
+  return defect_check(
+      "symplectic", prediction(x.predictions.symplectic), d,
+      form + scales +
+          (exact ? "M the exact tangent map (the implicit function theorem on the step's equations; noise: 10 times "
+                   "(2n eps + the solver's tolerance) times the form's entries)"
+                 : "M by Richardson-extrapolated central differences of a thousandth of those scales (noise: 10 times "
+                   "their change with the difference step)"));
 }
 
 // ---- momentum_conserved, energy_bounded: long runs at h and h/2 to the same time ---------------------

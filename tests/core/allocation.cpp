@@ -11,6 +11,7 @@
 #include "core/shooting_fixtures.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/galerkin_chart.hpp"
+#include "varia/core/one_step_map.hpp"
 #include "varia/core/shooting.hpp"
 #include "varia/sdk/groups/so3.hpp"
 
@@ -159,4 +160,39 @@ TEST_CASE("shooting steps in passes (R^8, jets of 16 variables over the 12 a jet
     CHECK(allocations_of_stepping(map, Eigen::VectorXd::LinSpaced(8, 1.3, 0.2), Eigen::VectorXd::Zero(8), 0.1, 10) ==
           0);
   }
+}
+
+// `steps` steps with the tangent map applied to one direction (a run observing megno), after one
+// that sizes the workspace.
+long allocations_of_tangent_steps(DiscreteHamiltonianMap& map, Eigen::VectorXd q, Eigen::VectorXd p, double h,
+                                  int steps) {
+  Eigen::VectorXd q1(q.size()), p1(p.size()), w = Eigen::VectorXd::Ones(2 * q.size()), w1(w.size());
+  map.step_with_tangent(q.data(), p.data(), 0.0, h, q1.data(), p1.data(), 1, w.data(), w1.data());
+  return allocations_of([&] {
+    for (int k = 0; k < steps; ++k) {
+      map.step_with_tangent(q1.data(), p1.data(), k * h, h, q.data(), p.data(), 1, w1.data(), w.data());
+      q.swap(q1);
+      p.swap(p1);
+      w.swap(w1);
+    }
+  });
+}
+
+TEST_CASE("steps with the tangent map allocate nothing: galerkin (Newton, the node iteration), shooting (SVIRK4), "
+          "one-step (gauss2)") {
+  FlatSpace space(2);
+  const Eigen::VectorXd q = Eigen::Vector2d(1.3, 0.4), p = Eigen::Vector2d(0.1, -0.2);
+  auto lobatto = lobatto3();
+  UndeclaredPendulums undeclared(2);
+  GalerkinDiscreteLagrangian newton(space, undeclared, lobatto, equispaced_control_times(2), {});
+  CHECK(allocations_of_tangent_steps(newton, q, p, 0.1, 20) == 0);
+  Pendulums declared(2);
+  GalerkinDiscreteLagrangian nodes(space, declared, lobatto, equispaced_control_times(2), {});
+  CHECK(allocations_of_tangent_steps(nodes, q, p, 0.1, 20) == 0);
+  auto method = rk4();
+  ShootingDiscreteLagrangian shooting(space, declared, lobatto, method, ShootingForm::lagrangian, {});
+  CHECK(allocations_of_tangent_steps(shooting, q, p, 0.1, 20) == 0);
+  auto gauss = gauss2();
+  OneStepHamiltonianMap one_step(space, declared, gauss, {});
+  CHECK(allocations_of_tangent_steps(one_step, q, p, 0.1, 20) == 0);
 }

@@ -15,7 +15,7 @@ namespace {
 using nlohmann::json;
 
 // Spec "Outputs": t, q0.., p0.., then energy; momentum0..; orthogonality; constraint;
-// constraint_velocity as asked.
+// constraint_velocity; megno; lyapunov as asked.
 std::vector<std::string> expected_header(const json& scene, int momentum_columns) {
   std::vector<std::string> columns{"t"};
   const auto& initial = scene["initial"];
@@ -26,7 +26,7 @@ std::vector<std::string> expected_header(const json& scene, int momentum_columns
   const auto asked = [&](const char* name) { return std::find(observe.begin(), observe.end(), name) != observe.end(); };
   if (asked("energy")) columns.emplace_back("energy");
   for (int i = 0; i < momentum_columns; ++i) columns.push_back("momentum" + std::to_string(i));
-  for (const char* name : {"orthogonality", "constraint", "constraint_velocity"})
+  for (const char* name : {"orthogonality", "constraint", "constraint_velocity", "megno", "lyapunov"})
     if (asked(name)) columns.emplace_back(name);
   return columns;
 }
@@ -60,6 +60,10 @@ void check_run_record(const json& scene, const json& record, long rows) {
   for (const char* name : {"constraint", "constraint_velocity"}) {
     const bool asked = std::find(observe.begin(), observe.end(), name) != observe.end();
     CHECK(record.contains(std::string(name) + "_error_max") == asked);
+  }
+  for (const char* name : {"megno", "lyapunov"}) {
+    const bool asked = std::find(observe.begin(), observe.end(), name) != observe.end();
+    CHECK(record.contains(std::string(name) + "_final") == asked);
   }
   CHECK_FALSE(record.contains("failure"));
   const auto& loaded = record["plugins_loaded"];

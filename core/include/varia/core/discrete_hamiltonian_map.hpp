@@ -48,10 +48,28 @@ class DiscreteHamiltonianMap {
   void advance(double* q, double* p, double h, long steps, double* q1, double* p1) {
     take_steps(q, p, 0.0, h, steps, q1, p1);
   }
+  // The tangent map (spec "Tangent maps and ensembles"): one step, as step() takes it, and the
+  // images d(q1, p1)/d(q0, p0) dx of `count` directions dx = (dq; dp), the columns of `directions`
+  // (2 dim() numbers each, column-major), into the columns of `images`. Exact: the implicit function
+  // theorem on the step's own equations at their solution, not differences of steps. In the natural
+  // chart's coordinates, which on a vector space are q's own. Throws std::logic_error where
+  // tangent_map_refusal() is not empty.
+  void step_with_tangent(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
+                         const double* directions, double* images) {
+    take_tangent_step(q0, p0, t0, h, q1, p1, count, directions, images);
+  }
+  // Empty where the map has its tangent map; else why it has none (the host refuses a scene that
+  // asks for it with this reason).
+  virtual std::string tangent_map_refusal() const { return "the tangent map of this construction is not derived yet"; }
   virtual const SolverStatistics& solver_statistics() const = 0;
   virtual const EvaluationCounters& evaluations() const = 0;
 
  protected:
+  virtual void take_tangent_step(const double* /*q0*/, const double* /*p0*/, double /*t0*/, double /*h*/,
+                                 double* /*q1*/, double* /*p1*/, int /*count*/, const double* /*directions*/,
+                                 double* /*images*/) {
+    throw std::logic_error(tangent_map_refusal());
+  }
   virtual void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) = 0;
   // The default takes one step after another, step k from t0 + k h (a product, not a sum: no
   // round-off accumulates in the time). A map may override it to keep its state in registers

@@ -44,6 +44,7 @@
 #include <Eigen/SparseCore>
 #include <Eigen/SparseLU>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "varia/core/constraints.hpp"
@@ -99,10 +100,16 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   const EvaluationCounters& evaluations() const override;
   // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).
   const std::vector<double>& last_residuals() const { return solver_.residuals(); }
+  // Empty for a dense Lagrangian without constraints (galerkin_tangent.cpp).
+  std::string tangent_map_refusal() const override;
 
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
   void take_steps(double* q, double* p, double t0, double h, long steps, double* q1, double* p1) override;
+  // The step, then the implicit function theorem on its equations E_nu(q^0..q^s) + p0 delta_nu0 = 0
+  // (nu < s), p1 = E_s, with E_nu = dS/dq^nu + f_d^nu (galerkin_tangent.cpp).
+  void take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
+                         const double* directions, double* images) override;
 
  private:
   // value: S only; gradient: dS/dq without S (the plugin is not asked for L); value_and_gradient;
@@ -175,6 +182,9 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // step_at<N, R> (node_iteration) or step_at<N, Dynamic> (exact Newton), N and R fixed where small.
   static StepFunction step_function(int n, int nodes, bool node_iteration);
   void factorize_sparse();
+  // The control points of the step just taken into origin_ and points_ (where the node iteration
+  // solved it, from the forces at its nodes; the explicit form's q^1 = q1).
+  void control_points_of_step(const double* q0, const double* q1, double h);
   // The sparse Jacobian's structure for these equations and unknowns (rebuilt when they change).
   void prepare_sparse(int first_unknown, int first_equation, int blocks);
   void gradient_after_update(double h, int first_unknown, Eigen::Ref<const Eigen::VectorXd> update, bool forced);
@@ -266,6 +276,11 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // column of u0, then its forces' columns times E_k^T); two_steps_back_ says whether the step
   // before the last is in the history (the last continued it with the same h).
   bool node_iteration_ = false;
+  bool step_at_nodes_ = false;  // the last step was solved by the node iteration
+  // The tangent map's workspace: the LU of the step's Newton Jacobian, d(E_0..E_{s-1})/d(q^1..q^s),
+  // the right-hand sides and the control points' images of the directions.
+  Eigen::PartialPivLU<Eigen::MatrixXd> tangent_lu_;
+  Eigen::MatrixXd tangent_rhs_, tangent_points_;
   Eigen::MatrixXd node_map_, control_map_, end_map_, prediction_map_[2];
   double mass_norm_ = 0.0;  // |M|_inf
   std::vector<int> iteration_nodes_;

@@ -9,6 +9,8 @@
 
 #include <Eigen/Core>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/abi/manifold.hpp"
@@ -26,8 +28,16 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
                         SolverOptions options);
   int point_size() const override { return m_; }
   int dim() const override { return n_; }
+  // Empty on a vector space with a Lagrangian that evaluates at jets.
+  std::string tangent_map_refusal() const override;
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
+  // The step, then the method's step at first-order jets along the directions: a one-step method
+  // steps jets with the exact derivatives of Psi_h (one_step.hpp), which is the implicit function
+  // theorem on its stage equations (Runge-Kutta methods commute with linearization). In passes of
+  // at most the field's jet_variables() directions.
+  void take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
+                         const double* directions, double* images) override;
 
  public:
   // The method's stage solves (zeros for explicit methods).
@@ -45,6 +55,9 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
   SolverOptions options_;
   SolverStatistics statistics_;
   Eigen::VectorXd y0_, y1_;
+  std::vector<Jet2> jets0_, jets1_;  // the tangent map's state at jets
+  Eigen::VectorXd deviation_w_;      // a direction's w part
+  SolverStatistics tangent_stages_;  // the jet steps' stage solves (not the run's)
 };
 
 }  // namespace varia

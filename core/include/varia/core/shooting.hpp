@@ -121,9 +121,16 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   const EvaluationCounters& evaluations() const override;
   // Residual norms of the last shooting solve, one per iteration (quadratic convergence).
   const std::vector<double>& last_residuals() const { return solver_.residuals(); }
+  // Empty on a vector space, in the lagrangian and hamiltonian forms, where one pass of jets
+  // holds the sensitivities (2n <= the jets' variables).
+  std::string tangent_map_refusal() const override;
 
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
+  // The step, then the implicit function theorem on its equation D1(x) + p0 = 0 in w0, x = (eta,
+  // w0): the shot at the solution again with all of Phi's second derivatives (shooting_solve.cpp).
+  void take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
+                         const double* directions, double* images) override;
 
  private:
   // What the Newton iteration on w0 drives to zero.
@@ -205,6 +212,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   std::vector<int> slot_;        // the current pass's jet variable of each number of x, or -1
   int jet_size_ = 0;             // the jets' number of variables in every pass (a pass may use fewer)
   bool second_order_ = true;     // whether the current solve needs Phi (its Jacobian does)
+  bool all_second_derivatives_ = false;  // Phi's columns in eta too (the tangent map's shot)
   SolverStatistics statistics_, stages_;
   mutable EvaluationCounters counters_;
   // The shot run inside the Lagrangian's plugin where it is explicit_shot.hpp's recurrence (an
@@ -238,6 +246,10 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::MatrixXd corrections_history_;
   int corrections_ = 0;
   SmallDenseSolver BwT_solver_, jacobian_solver_;  // of B_w^T and the Jacobian
+  // The tangent map's workspace: dlambda/dx and dD1/dx (n x 2n), the LUs of B_w^T and dD1/dw0, the
+  // directions' right-hand sides and dw0 (n x count).
+  Eigen::MatrixXd tangent_lambda_, tangent_d1_, tangent_rhs_, tangent_w_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> tangent_bw_lu_, tangent_lu_;
 };
 
 }  // namespace varia

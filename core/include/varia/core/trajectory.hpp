@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 #include <string>
 
+#include "varia/core/chaos_indicators.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
 
 namespace varia {
@@ -41,6 +42,15 @@ class Trajectory {
   long steps() const { return steps_; }  // steps taken so far
   double h() const { return h_; }
 
+  // From now on, every step also propagates the deviation vector w (2 dim() numbers, (dq; dp) in
+  // the natural chart's coordinates, nonzero) by the map's exact tangent map (the map's
+  // step_with_tangent), renormalized to unit length after each step, and the chaos indicators
+  // (chaos_indicators.hpp) take its growth. advance() then steps one step at a time.
+  void track_deviation(const Eigen::VectorXd& w);
+  bool tracks_deviation() const { return tracking_; }
+  const Eigen::VectorXd& deviation() const { return deviation_; }
+  const ChaosIndicators& chaos() const { return chaos_; }
+
   // One step. On failure (StepFailure) the state stays the last good one.
   void step();
   // `count` steps with nothing observed in between (the map's advance: the loop that `cost` and
@@ -66,6 +76,9 @@ class Trajectory {
   DiscreteHamiltonianMap& map_;
   Eigen::VectorXd q_, p_, q1_, p1_;
   Eigen::VectorXd q_start_, p_start_;  // advance_checked's state at the stretch's start
+  bool tracking_ = false;
+  Eigen::VectorXd deviation_, deviation1_;  // w before and after a step
+  ChaosIndicators chaos_;
   double t0_, h_;
   long steps_ = 0;
 };

@@ -147,6 +147,17 @@ SymplecticityDefect symplecticity_defect(DiscreteHamiltonianMap& map, Manifold& 
                                          const double* q0, const double* p0, double h,
                                          const Eigen::VectorXd& steps, const Eigen::MatrixXd& tangent = {});
 
+// The same defect (coordinate directions) with M the map's exact tangent map (step_with_tangent:
+// the implicit function theorem on the step's equations) at time t0, on a vector space. `noise`:
+// what the solve leaves, M exact at a solution of the equations to the solver's `tolerance`, and
+// round-off, (2n eps + tolerance) times the size of the rescaled form's entries.
+SymplecticityDefect exact_symplecticity_defect(DiscreteHamiltonianMap& map, const double* q0, const double* p0,
+                                               double t0, double h, const Eigen::VectorXd& steps, double tolerance);
+
+// ||M^T J M - J||_max of a map's Jacobian M (2n x 2n, coordinates (q, p)): zero exactly when M is
+// symplectic (the same defect as symplecticity_defect's, in unit scales).
+double symplecticity_residual(const Eigen::MatrixXd& M);
+
 // A basis of the tangent space at (q, p) of the constrained phase space {g(q) = 0, G(q) M^{-1} p =
 // 0} (M the constant mass matrix, dense here: a test of a property): positions along an
 // orthonormal basis z_j of ker G (times position_step) with the momentum change that keeps the

@@ -1,0 +1,193 @@
+// The exact tangent map d(q1, p1)/d(q0, p0) of every construction that has one (the implicit
+// function theorem on the step's own equations, discrete_hamiltonian_map.hpp) against central
+// differences of sixth order of the step itself, and M^T J M = J where the map is symplectic; where
+// it is not (a one-step method that is not symplectic, a damped system), the defect is measured as
+// not vanishing. Constructions without one say why.
+#include <doctest/doctest.h>
+
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "core/damped_drive.hpp"
+#include "core/fixtures.hpp"
+#include "core/shooting_fixtures.hpp"
+#include "varia/core/galerkin.hpp"
+#include "varia/core/galerkin_chart.hpp"
+#include "varia/core/one_step_map.hpp"
+#include "varia/core/shooting.hpp"
+#include "varia/core/verification.hpp"
+
+using namespace varia;
+using namespace varia::testing;
+
+namespace {
+
+struct TangentCase {
+  Eigen::MatrixXd exact, differences;
+};
+
+// The map's tangent map at (q0, p0, t0) with step h, and its sixth-order central differences
+// (difference step d in every coordinate) of the step's (q1, p1).
+TangentCase tangent_and_differences(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q0, const Eigen::VectorXd& p0,
+                                    double t0, double h, double d = 1e-3) {
+  const int n = static_cast<int>(q0.size()), size = 2 * n;
+  TangentCase result{Eigen::MatrixXd(size, size), Eigen::MatrixXd(size, size)};
+  Eigen::VectorXd q1(n), p1(n);
+  const Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(size, size);
+  map.step_with_tangent(q0.data(), p0.data(), t0, h, q1.data(), p1.data(), size, identity.data(),
+                        result.exact.data());
+  Eigen::VectorXd x0(size);
+  x0 << q0, p0;
+  const auto step = [&](const Eigen::VectorXd& x) {
+    Eigen::VectorXd a(n), b(n), y(size);
+    map.step(x.data(), x.data() + n, t0, h, a.data(), b.data());
+    y << a, b;
+    return y;
+  };
+  for (int j = 0; j < size; ++j) {
+    const Eigen::VectorXd e = d * identity.col(j);
+    result.differences.col(j) = (-step(x0 - 3 * e) + 9 * step(x0 - 2 * e) - 45 * step(x0 - e) + 45 * step(x0 + e) -
+                                 9 * step(x0 + 2 * e) + step(x0 + 3 * e)) /
+                                (60 * d);
+  }
+  return result;
+}
+
+// The tangent map agrees with the differences (their error: O(d^6) and eps / d) and its
+// symplecticity defect; the step continues from the last so that every warm start is exercised.
+double checked_defect(DiscreteHamiltonianMap& map, const Eigen::VectorXd& q0, const Eigen::VectorXd& p0, double h,
+                      double t0 = 0.0) {
+  const TangentCase m = tangent_and_differences(map, q0, p0, t0, h);
+  CHECK((m.exact - m.differences).cwiseAbs().maxCoeff() <= 1e-10);
+  return symplecticity_residual(m.exact);
+}
+
+Eigen::VectorXd vector_of(std::initializer_list<double> values) {
+  Eigen::VectorXd v(static_cast<Eigen::Index>(values.size()));
+  Eigen::Index i = 0;
+  for (double x : values) v[i++] = x;
+  return v;
+}
+
+}  // namespace
+
+TEST_CASE("galerkin's tangent map is exact and symplectic on every path: Newton, the node iteration, the explicit form") {
+  FlatSpace line(1), plane(2);
+  Pendulum pendulum;            // Newton with the exact Jacobian
+  SeparablePendulum separable;  // the node iteration (constant mass matrix)
+  DoublePendulum double_pendulum;
+  PlanarKepler kepler;
+  auto lobatto = lobatto3();
+  auto gauss = gauss_legendre(3);
+  auto trapezoid_rule = trapezoid();
+  const Eigen::VectorXd q = vector_of({1.3}), p = vector_of({0.2});
+  SUBCASE("newton, s = 2") {
+    GalerkinDiscreteLagrangian map(line, pendulum, lobatto, equispaced_control_times(2), {});
+    CHECK(map.tangent_map_refusal().empty());
+    CHECK(checked_defect(map, q, p, 0.1) <= 1e-13);
+  }
+  SUBCASE("node iteration, s = 3 with 3 gauss points") {
+    GalerkinDiscreteLagrangian map(line, separable, gauss, equispaced_control_times(3), {});
+    CHECK(checked_defect(map, q, p, 0.3) <= 1e-13);
+  }
+  SUBCASE("explicit form (Stormer-Verlet)") {
+    GalerkinDiscreteLagrangian map(line, separable, trapezoid_rule, equispaced_control_times(1), {});
+    CHECK(checked_defect(map, q, p, 0.1) <= 1e-13);
+  }
+  SUBCASE("kepler, e = 0.5 at its pericentre") {
+    GalerkinDiscreteLagrangian map(plane, kepler, lobatto, equispaced_control_times(2), {});
+    CHECK(checked_defect(map, vector_of({0.5, 0.0}), vector_of({0.0, std::sqrt(3.0)}), 0.05) <= 1e-13);
+  }
+  SUBCASE("the double pendulum (a configuration-dependent mass matrix)") {
+    GalerkinDiscreteLagrangian map(plane, double_pendulum, lobatto, equispaced_control_times(2), {});
+    CHECK(checked_defect(map, vector_of({2.0, 2.5}), vector_of({0.3, -0.1}), 0.05) <= 1e-13);
+  }
+}
+
+TEST_CASE("with forces the tangent map is exact and is measured not symplectic: the damped, driven oscillator") {
+  FlatSpace line(1);
+  Oscillator oscillator;
+  DampedDrive drive;
+  auto lobatto = lobatto3();
+  GalerkinDiscreteLagrangian map(line, oscillator, lobatto, equispaced_control_times(2), {}, {&drive});
+  // det M = e^{-c h} to the method's order: the form shrinks by about c h = 0.01 a step
+  const double defect = checked_defect(map, vector_of({1.0}), vector_of({0.0}), 0.1, 0.7);
+  CHECK(defect > 5e-3);
+  CHECK(defect < 2e-2);
+}
+
+TEST_CASE("the one-step construction's tangent map: jets through the method, symplectic for Gauss methods only") {
+  FlatSpace line(1), plane(2);
+  MassOscillator oscillator;  // (q, v) with the constant mass matrix
+  DoublePendulum double_pendulum;  // Hamilton's equations in (q, p)
+  SUBCASE("gauss2 on the double pendulum") {
+    auto method = gauss2();
+    OneStepHamiltonianMap map(plane, double_pendulum, method, {});
+    CHECK(map.tangent_map_refusal().empty());
+    CHECK(checked_defect(map, vector_of({2.0, 2.5}), vector_of({0.3, -0.1}), 0.05) <= 1e-13);
+  }
+  SUBCASE("implicit midpoint on the oscillator") {
+    auto method = implicit_midpoint();
+    OneStepHamiltonianMap map(line, oscillator, method, {});
+    CHECK(checked_defect(map, vector_of({1.0}), vector_of({0.5}), 0.2) <= 1e-14);
+  }
+  SUBCASE("explicit midpoint is not symplectic: det M = 1 + h^4/4 on the oscillator") {
+    auto method = explicit_midpoint();
+    OneStepHamiltonianMap map(line, oscillator, method, {});
+    const double defect = checked_defect(map, vector_of({1.0}), vector_of({0.5}), 0.2);
+    CHECK(defect == doctest::Approx(std::pow(0.2, 4) / 4).epsilon(1e-9));
+  }
+}
+
+TEST_CASE("shooting's tangent map: the lagrangian form (SVIRK4, its explicit shot run by the model's kernel) and the "
+          "hamiltonian form, and with forces") {
+  FlatSpace line(1), plane(2);
+  SeparablePendulum pendulum;
+  DoublePendulum double_pendulum;
+  auto rule = simpson();
+  auto method = rk4();
+  SUBCASE("SVIRK4 on the pendulum") {
+    ShootingDiscreteLagrangian map(line, pendulum, rule, method, ShootingForm::lagrangian, {});
+    CHECK(map.tangent_map_refusal().empty());
+    CHECK(checked_defect(map, vector_of({1.3}), vector_of({0.2}), 0.1) <= 1e-13);
+  }
+  SUBCASE("the hamiltonian form on the double pendulum with gauss2") {
+    auto gauss = gauss2();
+    ShootingDiscreteLagrangian map(plane, double_pendulum, rule, gauss, ShootingForm::hamiltonian, {});
+    CHECK(checked_defect(map, vector_of({2.0, 2.5}), vector_of({0.3, -0.1}), 0.05) <= 1e-13);
+  }
+  SUBCASE("the damped, driven oscillator: exact, and not symplectic") {
+    MassOscillator oscillator;
+    DampedDrive drive;
+    ShootingDiscreteLagrangian map(line, oscillator, rule, method, ShootingForm::lagrangian, {}, {&drive});
+    CHECK(checked_defect(map, vector_of({1.0}), vector_of({0.0}), 0.1, 0.7) > 5e-3);
+  }
+}
+
+TEST_CASE("constructions without a tangent map say why, and step_with_tangent refuses them") {
+  FlatSpace line(1), space(8);
+  SeparablePendulum pendulum;
+  Pendulums<> pendulums(8);
+  auto rule = simpson();
+  auto method = rk4();
+  ShootingDiscreteLagrangian type_2(line, pendulum, rule, method, ShootingForm::type_2, {});
+  CHECK(type_2.tangent_map_refusal().find("type-2") != std::string::npos);
+  ShootingDiscreteLagrangian passes(space, pendulums, rule, method, ShootingForm::lagrangian, {});
+  CHECK(passes.tangent_map_refusal().find("n = 8") != std::string::npos);
+  double q1 = 0, p1 = 0, image[2];
+  const double q0 = 1.0, p0 = 0.0, direction[2] = {1.0, 0.0};
+  CHECK_THROWS_AS(type_2.step_with_tangent(&q0, &p0, 0.0, 0.1, &q1, &p1, 1, direction, image), std::logic_error);
+  SparseChain chain(4, true);
+  FlatSpace four(4);
+  auto lobatto = lobatto3();
+  GalerkinDiscreteLagrangian sparse(four, chain, lobatto, equispaced_control_times(2), {});
+  CHECK(sparse.tangent_map_refusal().find("sparse") != std::string::npos);
+  Rotations rotations;
+  Top top(Eigen::Vector3d(1, 2, 3), 0.0, Eigen::Vector3d::Zero());
+  auto gauss = gauss2();
+  OneStepHamiltonianMap on_group(rotations, top, gauss, {});
+  CHECK(on_group.tangent_map_refusal().find("vector spaces") != std::string::npos);
+  LieGroupGalerkinDiscreteLagrangian chart(rotations, top, lobatto, equispaced_control_times(2), {});
+  CHECK(!chart.tangent_map_refusal().empty());
+}
