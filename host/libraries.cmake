@@ -9,7 +9,9 @@ find_package(CLI11 CONFIG REQUIRED)
 # through pkg-config (CMake's FindHDF5 wants the C language enabled, which this C++ project is not).
 find_package(PkgConfig REQUIRED)
 pkg_check_modules(HDF5 REQUIRED IMPORTED_TARGET GLOBAL hdf5)
-set(VARIA_HOST_LIBRARIES fmt::fmt CLI11::CLI11 PkgConfig::HDF5 ${CMAKE_DL_LIBS})
+# `varia ensemble` under mpirun: Open MPI's C interface (Debian: libopenmpi-dev), through pkg-config.
+pkg_check_modules(MPI REQUIRED IMPORTED_TARGET GLOBAL mpi-c)
+set(VARIA_HOST_LIBRARIES fmt::fmt CLI11::CLI11 PkgConfig::HDF5 PkgConfig::MPI ${CMAKE_DL_LIBS})
 file(GLOB VARIA_HOST_SOURCES CONFIGURE_DEPENDS ${CMAKE_CURRENT_LIST_DIR}/src/*.cpp
      ${CMAKE_CURRENT_LIST_DIR}/src/constructions/*.cpp)
 list(FILTER VARIA_HOST_SOURCES EXCLUDE REGEX "/main\\.cpp$")

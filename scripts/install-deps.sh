@@ -6,6 +6,7 @@ packages=(
   build-essential cmake ninja-build pkg-config
   libeigen3-dev libboost-dev nlohmann-json3-dev libfmt-dev doctest-dev libcli11-dev
   libvalijson-dev gnuplot-nox libhdf5-dev
+  libopenmpi-dev openmpi-bin  # varia ensemble under mpirun (docs/ensembles.md)
   clang libclang-rt-14-dev  # the scene fuzzer (ctest -L fuzz): libFuzzer
   gfortran  # bench_gni: the GNI peer (../shared/peers/gni) it times varia against
   pybind11-dev python3-dev python3-numpy python3-sympy python3-matplotlib  # the Python module (docs/python.md), for /usr/bin/python3

@@ -13,6 +13,7 @@
 #include <system_error>
 
 #include "commands.hpp"
+#include "ensemble.hpp"
 #include "cost.hpp"
 #include "crash.hpp"
 #include "errors.hpp"
@@ -98,6 +99,8 @@ struct Options {
   std::string run_out, run_summary, run_plot;
   LdOptions ld;
   TangentOptions tangent;
+  EnsembleOptions ensemble;
+  std::string ensemble_out, ensemble_plot;
   bool json = false;
   std::string verify_json, cost_out;
   std::vector<double> verify_h;
@@ -198,6 +201,40 @@ void define_tangent(CLI::App& app, Options& o, Command& chosen) {
   tangent->callback([&] { chosen = [&] { return command_tangent(o.common, o.scene, o.tangent); }; });
 }
 
+void define_ensemble(CLI::App& app, Options& o, Command& chosen) {
+  auto* ensemble = subcommand(
+      app, o, "ensemble",
+      "Run one member per element of the product of the --vary specs (the first slowest), each the scene with "
+      "its values set at their JSON pointers, run as `varia run` runs it, on --threads threads or, under "
+      "mpirun -n K, across K processes (rank 0 also hands members out and writes the file). FILE.h5 holds datasets "
+      "parameters, status (each member's own exit code; -1: not run yet), final_t, final_q, final_p and one per "
+      "run-record number (energy_error_max, megno_final, ...), and the scene and specs as attributes "
+      "(docs/ensembles.md). A member that fails is recorded and the rest run; --resume runs only the members the "
+      "file does not hold yet.",
+      "Example:\n  varia ensemble scenes/chaos/double-pendulum-megno.json --set /t_end=20 \\\n"
+      "      --vary /initial/q/0=linspace:-3:3:64 --vary /initial/q/1=linspace:-3:3:64 --out map.h5 --threads 2");
+  add_scene(ensemble, o, o.scene);
+  ensemble->add_option("--vary", o.ensemble.vary,
+                       "POINTER=linspace:A:B:N, POINTER=list:A,B,... or POINTER=uniform:A:B:N:SEED (repeatable)")
+      ->required()
+      ->type_name("POINTER=SPEC");
+  ensemble->add_option("--out", o.ensemble_out, "the ensemble's HDF5 file (a name ending in .h5)")
+      ->required()
+      ->type_name("FILE.h5");
+  ensemble->add_option("--threads", o.ensemble.threads, "members run at once in this process (default 1)")
+      ->type_name("N");
+  ensemble->add_flag("--resume", o.ensemble.resume, "run only the members FILE.h5 does not hold yet");
+  ensemble->add_option("--plot", o.ensemble_plot,
+                       "the stability map as SVG: MEGNO over the grid of the two --vary (the scene observes megno)")
+      ->type_name("FILE.svg");
+  ensemble->add_flag("--quiet", o.ensemble.quiet, "no progress line and no summary line");
+  ensemble->callback([&] {
+    o.ensemble.out = o.ensemble_out;
+    if (!o.ensemble_plot.empty()) o.ensemble.plot = o.ensemble_plot;
+    chosen = [&] { return command_ensemble(o.common, o.scene, o.ensemble); };
+  });
+}
+
 void define_validate(CLI::App& app, Options& o, Command& chosen) {
   auto* validate = subcommand(app, o, "validate",
                               "Check a scene against the scene schema and the plugins' parameter schemas, "
@@ -258,6 +295,7 @@ void define_commands(CLI::App& app, Options& o, Command& chosen) {
   define_run(app, o, chosen);
   define_ld(app, o, chosen);
   define_tangent(app, o, chosen);
+  define_ensemble(app, o, chosen);
   define_validate(app, o, chosen);
   define_verify(app, o, chosen);
   define_cost(app, o, chosen);

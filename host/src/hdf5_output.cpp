@@ -20,9 +20,8 @@ namespace {
 
 constexpr hsize_t kBlockRows = 1024;  // rows per append, and the datasets' chunk length
 
-// The cause HDF5 gives for the failure it just reported: its innermost error's description, or
-// where that quotes the system's message ("error message = '...'"), that message. Read before any
-// other call into the library, which clears its error stack.
+}  // namespace
+
 std::string hdf5_cause() {
   std::string description;
   const auto innermost = [](unsigned n, const H5E_error2_t* error, void* data) -> herr_t {
@@ -37,8 +36,6 @@ std::string hdf5_cause() {
   }
   return description.empty() ? "the HDF5 library gives no reason" : description;
 }
-
-}  // namespace
 
 Hdf5Writer::Lock::Lock(const std::filesystem::path& file) {
   fd_ = ::open(file.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);

@@ -21,6 +21,11 @@
 
 namespace varia::host {
 
+// The cause HDF5 gives for the failure it just reported: its innermost error's description, or
+// where that quotes the system's message ("error message = '...'"), that message. Read before any
+// other call into the library, which clears its error stack.
+std::string hdf5_cause();
+
 class Hdf5Writer final : public CrashSafeOutput {
  public:
   // Refuses (OutputError) a file that another run is writing or a program holds open through HDF5

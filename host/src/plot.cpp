@@ -143,4 +143,24 @@ void write_svg(const std::filesystem::path& file, const std::vector<Panel>& pane
   write_output(file, run_gnuplot(script), "the plot");
 }
 
+void write_map_svg(const std::filesystem::path& file, const GridMap& map) {
+  std::string script = "$map << EOD\n";
+  for (std::size_t i = 0; i < map.x.size(); ++i) {
+    for (std::size_t j = 0; j < map.y.size(); ++j) {
+      const double z = map.z[i * map.y.size() + j];
+      script += std::isfinite(z) ? fmt::format("{:.17g} {:.17g} {:.17g}\n", map.x[i], map.y[j], z)
+                                 : fmt::format("{:.17g} {:.17g} NaN\n", map.x[i], map.y[j]);
+    }
+    script += "\n";
+  }
+  script += "EOD\n";
+  script += fmt::format(
+      "set terminal svg size 640,560 dynamic enhanced font 'sans,11' background rgb 'white'\n"
+      "set datafile missing 'NaN'\nset title {} noenhanced\nset xlabel {} noenhanced\nset ylabel {} noenhanced\n"
+      "set cblabel {} noenhanced\nset cbrange [{:.17g}:{:.17g}]\nset palette rgbformulae 30,31,32\n"
+      "set size ratio -1\nset autoscale fix\nplot $map using 1:2:3 with image notitle\n",
+      label(map.title), label(map.xlabel), label(map.ylabel), label(map.zlabel), map.z_low, map.z_high);
+  write_output(file, run_gnuplot(script), "the plot");
+}
+
 }  // namespace varia::host

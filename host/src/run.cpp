@@ -416,7 +416,8 @@ RunOutcome run_scene(const Scene& scene, Assembly& assembly, const Registry& reg
                     {"message", failure->message}}}});
   else {
     const std::vector<std::string> warnings = departure_warnings(scene, assembly, stepper.observer());
-    for (const auto& warning : warnings) fmt::print(stderr, "varia: warning: {}\n", warning);
+    if (options.warnings)
+      for (const auto& warning : warnings) fmt::print(stderr, "varia: warning: {}\n", warning);
     write_record(warnings.empty() ? json::object() : json{{"warnings", warnings}});
   }
   if (options.plot) stepper.plot()->write(*options.plot);

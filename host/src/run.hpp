@@ -28,6 +28,7 @@ struct RunOptions {
   std::optional<std::filesystem::path> summary;  // run record JSON
   std::optional<std::filesystem::path> plot;     // SVG of q(t) and the energy error (or p(t))
   bool quiet = false;                             // no progress line, no human summary
+  bool warnings = true;                           // departure warnings on stderr (always in the record)
   TrajectoryRecorder* rows = nullptr;             // also receives the rows, when given
   nlohmann::json* record = nullptr;               // receives the run record, when given
 };
