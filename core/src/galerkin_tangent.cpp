@@ -6,6 +6,9 @@
 // J = d(E_0..E_{s-1})/dz the step's exact Newton Jacobian, and a direction (dq0, dp0):
 //   J dz = -(d(E_0..E_{s-1})/dq^0 dq0 + (dp0; 0)),   dq1 = dz's last block,
 //   dp1 = dE_s/dq^0 dq0 + dE_s/dz dz.
+#include <cmath>
+#include <utility>
+
 #include "varia/core/galerkin.hpp"
 
 namespace varia {
@@ -13,9 +16,6 @@ namespace varia {
 std::string GalerkinDiscreteLagrangian::tangent_map_refusal() const {
   if (constraints_ != nullptr)
     return "the Galerkin construction's tangent map is not derived with constraints yet";
-  if (lagrangian_.sparse())
-    return "the Galerkin construction's tangent map is derived for a Lagrangian with a dense Hessian; this one "
-           "declares a sparse Hessian (a composite)";
   return {};
 }
 
@@ -26,17 +26,49 @@ void GalerkinDiscreteLagrangian::take_tangent_step(const double* q0, const doubl
   take_step(q0, p0, t0, h, q1, p1);
   t_ = t0;
   control_points_of_step(q0, q1, h);
-  action(h, Order::hessian, !forces_.empty());
   const int n = n_, m = s_ * n_;
   using Strided = Eigen::Map<const Eigen::MatrixXd, 0, Eigen::OuterStride<>>;
   const Strided dq0(directions, n, count, Eigen::OuterStride<>(2 * n));
   const Strided dp0(directions + n, n, count, Eigen::OuterStride<>(2 * n));
+  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dq1(images, n, count, Eigen::OuterStride<>(2 * n));
+  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dp1(images + n, n, count, Eigen::OuterStride<>(2 * n));
+  if (lagrangian_.sparse()) {
+    // The full Jacobian in a structure of its own, so that the step's Newton keeps its analysed one.
+    const auto swap_structures = [this] {
+      std::swap(sparse_.first_unknown, tangent_sparse_.first_unknown);
+      std::swap(sparse_.first_equation, tangent_sparse_.first_equation);
+      std::swap(sparse_.blocks, tangent_sparse_.blocks);
+      sparse_.matrix.swap(tangent_sparse_.matrix);
+      sparse_.slots.swap(tangent_sparse_.slots);
+      std::swap(sparse_.analyzed, tangent_sparse_.analyzed);
+    };
+    swap_structures();
+    struct SwapBack {
+      const decltype(swap_structures)& swap;
+      ~SwapBack() { swap(); }
+    } swap_back{swap_structures};
+    prepare_sparse(0, 0, s_ + 1);
+    action(h, Order::hessian, !forces_.empty());
+    const Eigen::SparseMatrix<double>& H = sparse_.matrix;
+    tangent_block_ = H.block(0, n, m, m);
+    tangent_sparse_lu_.compute(tangent_block_);
+    if (tangent_sparse_lu_.info() != Eigen::Success)
+      throw NumericalFailure("the Galerkin Newton Jacobian is singular at the step's solution (its tangent map): " +
+                                 tangent_sparse_lu_.lastErrorMessage(),
+                             std::nan(""));
+    tangent_rhs_.noalias() = -(H.block(0, 0, m, n) * dq0);
+    tangent_rhs_.topRows(n) -= dp0;
+    tangent_points_ = tangent_sparse_lu_.solve(tangent_rhs_);
+    dq1 = tangent_points_.bottomRows(n);
+    dp1.noalias() = H.block(m, 0, n, n) * dq0;
+    dp1.noalias() += H.block(m, n, n, m) * tangent_points_;
+    return;
+  }
+  action(h, Order::hessian, !forces_.empty());
   tangent_lu_.compute(hessian_.block(0, n, m, m));
   tangent_rhs_.noalias() = -hessian_.block(0, 0, m, n) * dq0;
   tangent_rhs_.topRows(n) -= dp0;
   tangent_points_.noalias() = tangent_lu_.solve(tangent_rhs_);
-  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dq1(images, n, count, Eigen::OuterStride<>(2 * n));
-  Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dp1(images + n, n, count, Eigen::OuterStride<>(2 * n));
   dq1 = tangent_points_.bottomRows(n);
   dp1.noalias() = hessian_.block(m, 0, n, n) * dq0;
   dp1.noalias() += hessian_.block(m, n, n, m) * tangent_points_;

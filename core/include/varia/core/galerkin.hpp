@@ -100,7 +100,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   const EvaluationCounters& evaluations() const override;
   // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).
   const std::vector<double>& last_residuals() const { return solver_.residuals(); }
-  // Empty for a dense Lagrangian without constraints (galerkin_tangent.cpp).
+  // Empty without constraints (galerkin_tangent.cpp).
   std::string tangent_map_refusal() const override;
 
  protected:
@@ -253,6 +253,11 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
     bool analyzed = false;
   };
   SparseJacobian sparse_;
+  // A sparse Lagrangian's tangent map: the Jacobian of all s + 1 equations in all control points (its
+  // own structure, swapped into sparse_ while the action fills it), the Newton block and its LU.
+  SparseJacobian tangent_sparse_;
+  Eigen::SparseMatrix<double> tangent_block_;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> tangent_sparse_lu_;
   ActionFunction action_ = nullptr;
   // The explicit form: its steps (null when it does not apply), endpoint weights, M and M^{-1},
   // and, at the last (q1, p1) with step previous_h_, dL/dq and the increment h v (reused by a step
