@@ -183,13 +183,24 @@ void ShootingDiscreteLagrangian::offer_explicit_shot(Lagrangian& lagrangian) {
 // eta with a block of w0 and over two blocks of w0 (capacity / 2 numbers each): of the order of
 // (n / (capacity / 2))^2 propagations, each of jets of `capacity` variables, instead of one of
 // jets of 2n (2n + 4n^2 numbers each).
+namespace {
+
+// The numbers [first, first + count) of x.
+std::vector<int> block(int first, int count) {
+  std::vector<int> variables(count);
+  for (int j = 0; j < count; ++j) variables[j] = first + j;
+  return variables;
+}
+
+std::vector<int> joined(std::vector<int> a, const std::vector<int>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
+}  // namespace
+
 void ShootingDiscreteLagrangian::plan_passes(int capacity) {
   const int V = 2 * n_;
-  const auto block = [](int first, int count) {
-    std::vector<int> variables(count);
-    for (int j = 0; j < count; ++j) variables[j] = first + j;
-    return variables;
-  };
   jet_size_ = std::min(V, capacity);  // every pass's jets alike: a method's workspace keeps its size
   if (V <= capacity) {
     passes_.push_back({block(0, V), true, true});
@@ -203,14 +214,19 @@ void ShootingDiscreteLagrangian::plan_passes(int capacity) {
     eta.push_back(block(first, std::min(half, n_ - first)));
     w0.push_back(block(n_ + first, std::min(half, n_ - first)));
   }
-  const auto joined = [](std::vector<int> a, const std::vector<int>& b) {
-    a.insert(a.end(), b.begin(), b.end());
-    return a;
-  };
   for (const auto& a : eta)
     for (const auto& b : w0) passes_.push_back({joined(a, b), false, true});
   for (std::size_t b = 0; b < w0.size(); ++b)
     for (std::size_t c = b + 1; c < w0.size(); ++c) passes_.push_back({joined(w0[b], w0[c]), false, true});
+  // The tangent map's shot needs Phi's columns in eta too: every pair of blocks of x, after the
+  // first-order passes.
+  std::vector<std::vector<int>> blocks;
+  for (int first = 0; first < V; first += half) blocks.push_back(block(first, std::min(half, V - first)));
+  for (const Pass& pass : passes_)
+    if (pass.first_order) tangent_passes_.push_back(pass);
+  for (std::size_t b = 0; b < blocks.size(); ++b)
+    for (std::size_t c = b + 1; c < blocks.size(); ++c)
+      tangent_passes_.push_back({joined(blocks[b], blocks[c]), false, true});
 }
 
 // Every number of the state carries the pass's variables, with zero derivatives where it does not

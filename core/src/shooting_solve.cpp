@@ -272,35 +272,36 @@ void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
 
 std::string ShootingDiscreteLagrangian::tangent_map_refusal() const {
   if (mechanical_ == nullptr) return "the shooting construction's tangent map is derived on vector spaces only yet";
-  if (type_2())
-    return "the shooting construction's tangent map is derived for the lagrangian and hamiltonian forms; the type-2 "
-           "form's is not yet";
-  if (passes_.size() != 1)
-    return "the shooting construction's tangent map takes every second derivative of the shot from one pass of jets "
-           "(2n <= " + std::to_string(jet_size_) + " variables); this system has n = " + std::to_string(n_);
   return {};
 }
 
-// With lambda(x) = B_w^{-T} alpha_w and the step's D1(x) = alpha_eta - (I + B_eta)^T lambda (the
-// offsets' B = q^n - q0 - eta), Phi = G + W - <lambda, B> with lambda frozen (shooting.hpp):
-//   dlambda/dx = B_w^{-T} Phi_wx,   dD1/dx = Phi_etax - (I + B_eta)^T dlambda/dx,
-// and the step D1 + p0 = 0, q1 = q0 + eta + B, p1 = lambda gives, for a direction (dq0, dp0) = (deta, dp0):
-//   dw0 = -(dD1/dw0)^{-1} (dp0 + dD1/deta dq0),
-//   dq1 = (I + B_eta) dq0 + B_w dw0,   dp1 = dlambda/deta dq0 + dlambda/dw0 dw0.
+// With lambda(x) = B_w^{-T} alpha_w and Phi = G + W - <lambda, B> with lambda frozen (shooting.hpp),
+// dlambda/dx = B_w^{-T} Phi_wx, and for a direction (dq0, dp0) = (deta, dp0):
+// - Type I forms, D1(x) = alpha_eta - (I + B_eta)^T lambda (the offsets' B = q^n - q0 - eta):
+//   dD1/dx = Phi_etax - (I + B_eta)^T dlambda/dx, and the step D1 + p0 = 0, q1 = q0 + eta + B,
+//   p1 = lambda gives dw0 = -(dD1/dw0)^{-1} (dp0 + dD1/deta dq0), dq1 = (I + B_eta) dq0 + B_w dw0,
+//   dp1 = dlambda/deta dq0 + dlambda/dw0 dw0;
+// - the type-2 form, D1 H_d^+(x) = alpha_eta - B_eta^T lambda + B (B = p^n): dD1/dx = Phi_etax -
+//   B_eta^T dlambda/dx + B_x, and the step D1 - p0 = 0, q1 = q0 + eta + lambda, p1 = B gives
+//   dw0 = (dD1/dw0)^{-1} (dp0 - dD1/deta dq0), dq1 = (I + dlambda/deta) dq0 + dlambda/dw0 dw0,
+//   dp1 = B_eta dq0 + B_w dw0.
 void ShootingDiscreteLagrangian::take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1,
                                                    double* p1, int count, const double* directions, double* images) {
   if (const std::string refusal = tangent_map_refusal(); !refusal.empty()) throw std::logic_error(refusal);
   take_step(q0, p0, t0, h, q1, p1);
   // The shot at the solution w0 again, through the method's plugin, with Phi's columns in eta (the
   // step's shot, and a plugin's kernel, form only those in w0).
+  // In passes, those of every pair of blocks of x (plan_passes).
   struct Restore {
     ShootingDiscreteLagrangian& s;
     bool plugin;
     ~Restore() {
       s.plugin_shoots_ = plugin;
       s.all_second_derivatives_ = false;
+      if (!s.tangent_passes_.empty()) s.passes_.swap(s.tangent_passes_);
     }
   } restore{*this, plugin_shoots_};
+  if (!tangent_passes_.empty()) passes_.swap(tangent_passes_);
   plugin_shoots_ = false;
   all_second_derivatives_ = true;
   second_order_ = true;
@@ -312,19 +313,33 @@ void ShootingDiscreteLagrangian::take_tangent_step(const double* q0, const doubl
   tangent_bw_lu_.compute(Bw_.transpose());
   tangent_lambda_ = tangent_bw_lu_.solve(phi_.bottomRows(n));
   tangent_d1_ = phi_.topRows(n);
-  tangent_d1_ -= tangent_lambda_;
   tangent_d1_.noalias() -= Bq_.transpose() * tangent_lambda_;
+  if (type_2()) {
+    tangent_d1_.leftCols(n) += Bq_;
+    tangent_d1_.rightCols(n) += Bw_;
+  } else {
+    tangent_d1_ -= tangent_lambda_;
+  }
   tangent_lu_.compute(tangent_d1_.rightCols(n));
-  tangent_rhs_ = -dp0;
+  tangent_rhs_ = dp0;
+  if (!type_2()) tangent_rhs_ = -tangent_rhs_;
   tangent_rhs_.noalias() -= tangent_d1_.leftCols(n) * dq0;
   tangent_w_.noalias() = tangent_lu_.solve(tangent_rhs_);
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dq1(images, n, count, Eigen::OuterStride<>(2 * n));
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dp1(images + n, n, count, Eigen::OuterStride<>(2 * n));
+  // Type I: the position's offset is B and the momentum lambda; type 2 the other way round.
   dq1 = dq0;
-  dq1.noalias() += Bq_ * dq0;
-  dq1.noalias() += Bw_ * tangent_w_;
-  dp1.noalias() = tangent_lambda_.leftCols(n) * dq0;
-  dp1.noalias() += tangent_lambda_.rightCols(n) * tangent_w_;
+  if (type_2()) {
+    dq1.noalias() += tangent_lambda_.leftCols(n) * dq0;
+    dq1.noalias() += tangent_lambda_.rightCols(n) * tangent_w_;
+    dp1.noalias() = Bq_ * dq0;
+    dp1.noalias() += Bw_ * tangent_w_;
+  } else {
+    dq1.noalias() += Bq_ * dq0;
+    dq1.noalias() += Bw_ * tangent_w_;
+    dp1.noalias() = tangent_lambda_.leftCols(n) * dq0;
+    dp1.noalias() += tangent_lambda_.rightCols(n) * tangent_w_;
+  }
 }
 
 ShootingDiscreteLagrangian::StepFunction ShootingDiscreteLagrangian::step_function(int n, bool vector_space) {

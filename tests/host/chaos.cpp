@@ -22,8 +22,10 @@ Eigen::MatrixXd matrix_of(const json& rows) {
   return M;
 }
 
-TEST_CASE("tangent --json prints q1, p1 and the step's Jacobian, symplectic for SVIRK4 and Galerkin on Kepler") {
+TEST_CASE("tangent --json prints q1, p1 and the step's Jacobian, symplectic for SVIRK4 (type I and type 2) and Galerkin on "
+          "Kepler") {
   for (const char* arguments : {"scenes/paper/svirk4-pendulum.json --q0 1.3 --p0 0.2 --h 0.1",
+                                "scenes/paper/svirk4-pendulum-type2.json --q0 1.3 --p0 0.2 --h 0.1",
                                 "scenes/kepler-galerkin.json --q0 0.5,0 --p0 0,1.7320508075688772 --h 0.05"}) {
     CAPTURE(arguments);
     const auto outcome = run_varia(std::string("tangent ") + arguments + " --json");
@@ -42,9 +44,10 @@ TEST_CASE("tangent --json prints q1, p1 and the step's Jacobian, symplectic for 
 }
 
 TEST_CASE("tangent refuses what has no tangent map and bad flags, exit 2 with one line") {
-  const auto type_2 = run_varia("tangent scenes/paper/svirk4-pendulum-type2.json --q0 1 --p0 0 --h 0.1");
-  CHECK(type_2.code == 2);
-  check_one_error_line(type_2, "/method/construction: expected a construction with a tangent map");
+  const auto lgvi =
+      run_varia("tangent scenes/paper/rigid-body-lgvi.json --q0 1,0,0,0,1,0,0,0,1 --p0 0.1,0.2,0.3 --h 0.1");
+  CHECK(lgvi.code == 2);
+  check_one_error_line(lgvi, "/method/construction: expected a construction with a tangent map");
   const auto p0 = run_varia("tangent scenes/kepler-galerkin.json --q0 0.5,0 --p0 1 --h 0.05");
   CHECK(p0.code == 2);
   check_one_error_line(p0, "--p0: expected 2 comma-separated finite numbers");

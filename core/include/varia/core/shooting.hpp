@@ -121,14 +121,14 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   const EvaluationCounters& evaluations() const override;
   // Residual norms of the last shooting solve, one per iteration (quadratic convergence).
   const std::vector<double>& last_residuals() const { return solver_.residuals(); }
-  // Empty on a vector space, in the lagrangian and hamiltonian forms, where one pass of jets
-  // holds the sensitivities (2n <= the jets' variables).
+  // Empty on a vector space (every form, any dimension).
   std::string tangent_map_refusal() const override;
 
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
-  // The step, then the implicit function theorem on its equation D1(x) + p0 = 0 in w0, x = (eta,
-  // w0): the shot at the solution again with all of Phi's second derivatives (shooting_solve.cpp).
+  // The step, then the implicit function theorem on its equation D1(x) + p0 = 0 (type 2:
+  // D1 H_d^+(x) - p0 = 0) in w0, x = (eta, w0): the shot at the solution again with all of Phi's
+  // second derivatives (shooting_solve.cpp).
   void take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
                          const double* directions, double* images) override;
 
@@ -209,6 +209,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   bool target_is_end_ = false;  // B's chart at q^n's value (a step) or at target_ (evaluate)
   std::vector<double> target_, zero_;
   std::vector<Pass> passes_;
+  std::vector<Pass> tangent_passes_;  // where there are several: passes giving all of Phi (the tangent map's)
   std::vector<int> slot_;        // the current pass's jet variable of each number of x, or -1
   int jet_size_ = 0;             // the jets' number of variables in every pass (a pass may use fewer)
   bool second_order_ = true;     // whether the current solve needs Phi (its Jacobian does)
