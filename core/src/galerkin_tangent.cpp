@@ -22,7 +22,6 @@ std::string GalerkinDiscreteLagrangian::tangent_map_refusal() const {
 void GalerkinDiscreteLagrangian::take_tangent_step(const double* q0, const double* p0, double t0, double h,
                                                    double* q1, double* p1, int count, const double* directions,
                                                    double* images) {
-  if (const std::string refusal = tangent_map_refusal(); !refusal.empty()) throw std::logic_error(refusal);
   take_step(q0, p0, t0, h, q1, p1);
   t_ = t0;
   control_points_of_step(q0, q1, h);
@@ -32,46 +31,43 @@ void GalerkinDiscreteLagrangian::take_tangent_step(const double* q0, const doubl
   const Strided dp0(directions + n, n, count, Eigen::OuterStride<>(2 * n));
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dq1(images, n, count, Eigen::OuterStride<>(2 * n));
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dp1(images + n, n, count, Eigen::OuterStride<>(2 * n));
-  if (lagrangian_.sparse()) {
-    // The full Jacobian in a structure of its own, so that the step's Newton keeps its analysed one.
-    const auto swap_structures = [this] {
-      std::swap(sparse_.first_unknown, tangent_sparse_.first_unknown);
-      std::swap(sparse_.first_equation, tangent_sparse_.first_equation);
-      std::swap(sparse_.blocks, tangent_sparse_.blocks);
-      sparse_.matrix.swap(tangent_sparse_.matrix);
-      sparse_.slots.swap(tangent_sparse_.slots);
-      std::swap(sparse_.analyzed, tangent_sparse_.analyzed);
-    };
-    swap_structures();
-    struct SwapBack {
-      const decltype(swap_structures)& swap;
-      ~SwapBack() { swap(); }
-    } swap_back{swap_structures};
-    prepare_sparse(0, 0, s_ + 1);
-    action(h, Order::hessian, !forces_.empty());
-    const Eigen::SparseMatrix<double>& H = sparse_.matrix;
-    tangent_block_ = H.block(0, n, m, m);
-    tangent_sparse_lu_.compute(tangent_block_);
-    if (tangent_sparse_lu_.info() != Eigen::Success)
-      throw NumericalFailure("the Galerkin Newton Jacobian is singular at the step's solution (its tangent map): " +
-                                 tangent_sparse_lu_.lastErrorMessage(),
-                             std::nan(""));
-    tangent_rhs_.noalias() = -(H.block(0, 0, m, n) * dq0);
+  // The images from H (dense or sparse) and the LU of its Newton block J = H(0..m, n..n+m).
+  const auto images_from = [&](const auto& H, const auto& lu) {
+    tangent_rhs_.noalias() = -H.block(0, 0, m, n) * dq0;
     tangent_rhs_.topRows(n) -= dp0;
-    tangent_points_ = tangent_sparse_lu_.solve(tangent_rhs_);
+    tangent_points_.noalias() = lu.solve(tangent_rhs_);
     dq1 = tangent_points_.bottomRows(n);
     dp1.noalias() = H.block(m, 0, n, n) * dq0;
     dp1.noalias() += H.block(m, n, n, m) * tangent_points_;
-    return;
+  };
+  if (!lagrangian_.sparse()) {
+    action(h, Order::hessian, !forces_.empty());
+    tangent_lu_.compute(hessian_.block(0, n, m, m));
+    return images_from(hessian_, tangent_lu_);
   }
+  // The full Jacobian in a structure of its own, so that the step's Newton keeps its analysed one.
+  const auto swap_structures = [this] {
+    std::swap(sparse_.first_unknown, tangent_sparse_.first_unknown);
+    std::swap(sparse_.first_equation, tangent_sparse_.first_equation);
+    std::swap(sparse_.blocks, tangent_sparse_.blocks);
+    sparse_.matrix.swap(tangent_sparse_.matrix);
+    sparse_.slots.swap(tangent_sparse_.slots);
+    std::swap(sparse_.analyzed, tangent_sparse_.analyzed);
+  };
+  swap_structures();
+  struct SwapBack {
+    const decltype(swap_structures)& swap;
+    ~SwapBack() { swap(); }
+  } swap_back{swap_structures};
+  prepare_sparse(0, 0, s_ + 1);
   action(h, Order::hessian, !forces_.empty());
-  tangent_lu_.compute(hessian_.block(0, n, m, m));
-  tangent_rhs_.noalias() = -hessian_.block(0, 0, m, n) * dq0;
-  tangent_rhs_.topRows(n) -= dp0;
-  tangent_points_.noalias() = tangent_lu_.solve(tangent_rhs_);
-  dq1 = tangent_points_.bottomRows(n);
-  dp1.noalias() = hessian_.block(m, 0, n, n) * dq0;
-  dp1.noalias() += hessian_.block(m, n, n, m) * tangent_points_;
+  tangent_block_ = sparse_.matrix.block(0, n, m, m);
+  tangent_sparse_lu_.compute(tangent_block_);
+  if (tangent_sparse_lu_.info() != Eigen::Success)
+    throw NumericalFailure("the Galerkin Newton Jacobian is singular at the step's solution (its tangent map): " +
+                               tangent_sparse_lu_.lastErrorMessage(),
+                           std::nan(""));
+  images_from(sparse_.matrix, tangent_sparse_lu_);
 }
 
 }  // namespace varia

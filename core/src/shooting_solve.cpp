@@ -287,7 +287,6 @@ std::string ShootingDiscreteLagrangian::tangent_map_refusal() const {
 //   dp1 = B_eta dq0 + B_w dw0.
 void ShootingDiscreteLagrangian::take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1,
                                                    double* p1, int count, const double* directions, double* images) {
-  if (const std::string refusal = tangent_map_refusal(); !refusal.empty()) throw std::logic_error(refusal);
   take_step(q0, p0, t0, h, q1, p1);
   // The shot at the solution w0 again, through the method's plugin, with Phi's columns in eta (the
   // step's shot, and a plugin's kernel, form only those in w0).

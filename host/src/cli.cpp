@@ -64,30 +64,14 @@ int guarded(const std::function<int()>& command) {
   } catch (const Interrupted& e) {
     report(e.what());
     return 128 + e.signal();
-  } catch (const InputError& e) {
-    report(e.what());
-    return kExitInput;
-  } catch (const PluginLoadError& e) {
-    report(e.what());
-    return kExitPlugin;
-  } catch (const PluginFault& e) {
-    report(fmt::format("plugin fault: {}", e.what()));
-    return kExitPlugin;
-  } catch (const NumericalFailure& e) {
-    report(fmt::format("numerical failure: {}", e.what()));
-    return kExitNumerical;
   } catch (const std::system_error& e) {  // fmt printing to a stdout or stderr that refuses it
     report(fmt::format("stdout or stderr: the results cannot be written: {}", e.what()));
     return kExitInput;
-  } catch (const std::invalid_argument& e) {  // a core constructor refusing its arguments
-    report(e.what());
-    return kExitInput;
-  } catch (const std::bad_alloc&) {  // not a numerical failure: what was asked for is too large
-    report("out of memory: the scene or the flags ask for more memory than this machine gives");
-    return kExitInput;
-  } catch (const std::exception& e) {
-    report(fmt::format("unexpected failure: {}", e.what()));
-    return kExitPlugin;
+  } catch (const std::exception&) {
+    std::string message;
+    const int code = exit_code_of(std::current_exception(), message);
+    report(message);
+    return code;
   }
 }
 

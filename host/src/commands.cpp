@@ -6,6 +6,7 @@
 #include <cerrno>
 #include <cmath>
 #include <cstdlib>
+#include <functional>
 #include <map>
 #include <stdexcept>
 #include <string_view>
@@ -23,7 +24,6 @@ using nlohmann::json;
 
 namespace {
 
-Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
 
 // Loads a scene file, applies the --set settings, and assembles it; every InputError about the scene
 // is prefixed with the file's name.
@@ -134,6 +134,11 @@ Eigen::VectorXd parse_point(const std::string& text, Manifold& manifold, const s
   return q;
 }
 
+// --h of ld and tangent: one step of that size.
+void check_one_step(double h) {
+  if (!(h > 0.0) || !std::isfinite(h)) throw InputError(fmt::format("--h: expected a number > 0; found {}", h));
+}
+
 }  // namespace
 
 nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records) {
@@ -147,6 +152,8 @@ nlohmann::ordered_json plugins_json(const std::vector<PluginRecord>& records) {
                      {"parameter_schema", r.parameter_schema}});
   return array;
 }
+
+Registry make_registry(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
 
 Prepared prepare_document(const json& document, Registry& registry) {
   try {
@@ -224,8 +231,7 @@ nlohmann::ordered_json discrete_lagrangian(Prepared& prepared, const LdOptions& 
   if (a.discrete_lagrangian == nullptr)
     throw InputError(fmt::format("/method/construction: construction '{}' has no discrete Lagrangian",
                                  prepared.scene.construction->name()));
-  if (!(options.h > 0.0) || !std::isfinite(options.h))
-    throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
+  check_one_step(options.h);
   const Eigen::VectorXd q0 = parse_point(options.q0, *a.manifold, prepared.scene.manifold.type, "--q0");
   const Eigen::VectorXd q1 = parse_point(options.q1, *a.manifold, prepared.scene.manifold.type, "--q1");
   double ld = 0.0;
@@ -240,32 +246,45 @@ nlohmann::ordered_json discrete_lagrangian(Prepared& prepared, const LdOptions& 
   return nlohmann::ordered_json{{"Ld", ld}, {"D1", as_vector(d1)}, {"D2", as_vector(d2)}};
 }
 
-int command_ld(const CommonOptions& common, const std::string& scene_file, const LdOptions& options) {
+namespace {
+
+// ld and tangent: the scene prepared, `compute`'s result at the flags' point (an InputError about
+// the point or the construction naming the scene file), printed as JSON with --json, else by `human`.
+int point_command(const CommonOptions& common, const std::string& scene_file, bool as_json,
+                  const std::function<nlohmann::ordered_json(Prepared&)>& compute,
+                  const std::function<void(const nlohmann::ordered_json&)>& human) {
   return with_registry(common, [&](Registry& registry) {
     Prepared prepared = prepare(scene_file, common, registry);
     nlohmann::ordered_json result;
     try {
-      result = discrete_lagrangian(prepared, options);
+      result = compute(prepared);
     } catch (const InputError& e) {
       if (e.what()[0] != '/') throw;
       throw InputError(fmt::format("{}: {}", scene_file, e.what()));
     }
-    if (options.json) {
-      fmt::print(results(), "{}\n", result.dump());
-      return 0;
-    }
-    fmt::print(results(), "Ld = {}\nD1 = [{}]\nD2 = [{}]\n", result["Ld"].get<double>(),
-               fmt::join(result["D1"].get<std::vector<double>>(), ", "), fmt::join(result["D2"].get<std::vector<double>>(), ", "));
+    if (as_json) fmt::print(results(), "{}\n", result.dump());
+    else human(result);
     return 0;
   });
+}
+
+}  // namespace
+
+int command_ld(const CommonOptions& common, const std::string& scene_file, const LdOptions& options) {
+  return point_command(
+      common, scene_file, options.json, [&](Prepared& prepared) { return discrete_lagrangian(prepared, options); },
+      [](const nlohmann::ordered_json& result) {
+        fmt::print(results(), "Ld = {}\nD1 = [{}]\nD2 = [{}]\n", result["Ld"].get<double>(),
+                   fmt::join(result["D1"].get<std::vector<double>>(), ", "),
+                   fmt::join(result["D2"].get<std::vector<double>>(), ", "));
+      });
 }
 
 nlohmann::ordered_json tangent_map(Prepared& prepared, const TangentOptions& options) {
   Assembly& a = prepared.assembly;
   if (const std::string refusal = a.map->tangent_map_refusal(); !refusal.empty())
     throw InputError(fmt::format("/method/construction: expected a construction with a tangent map: {}", refusal));
-  if (!(options.h > 0.0) || !std::isfinite(options.h))
-    throw InputError(fmt::format("--h: expected a number > 0; found {}", options.h));
+  check_one_step(options.h);
   const Eigen::VectorXd q0 = parse_point(options.q0, *a.manifold, prepared.scene.manifold.type, "--q0");
   const Eigen::VectorXd p0 = parse_numbers(options.p0, a.map->dim(), "--p0");
   const int d = 2 * a.map->dim();
@@ -284,31 +303,21 @@ nlohmann::ordered_json tangent_map(Prepared& prepared, const TangentOptions& opt
 }
 
 int command_tangent(const CommonOptions& common, const std::string& scene_file, const TangentOptions& options) {
-  return with_registry(common, [&](Registry& registry) {
-    Prepared prepared = prepare(scene_file, common, registry);
-    nlohmann::ordered_json result;
-    try {
-      result = tangent_map(prepared, options);
-    } catch (const InputError& e) {
-      if (e.what()[0] != '/') throw;
-      throw InputError(fmt::format("{}: {}", scene_file, e.what()));
-    }
-    if (options.json) {
-      fmt::print(results(), "{}\n", result.dump());
-      return 0;
-    }
-    fmt::print(results(), "q1 = [{}]\np1 = [{}]\nd(q1, p1)/d(q0, p0) =\n", fmt::join(result["q1"].get<std::vector<double>>(), ", "),
-               fmt::join(result["p1"].get<std::vector<double>>(), ", "));
-    const int d = static_cast<int>(result["jacobian"].size());
-    Eigen::MatrixXd M(d, d);
-    for (int r = 0; r < d; ++r) {
-      const auto row = result["jacobian"][r].get<std::vector<double>>();
-      fmt::print(results(), "  {:>24.16e}\n", fmt::join(row, " "));
-      for (int c = 0; c < d; ++c) M(r, c) = row[c];
-    }
-    fmt::print(results(), "symplecticity defect max |M^T J M - J| = {:.3e}\n", symplecticity_residual(M));
-    return 0;
-  });
+  return point_command(
+      common, scene_file, options.json, [&](Prepared& prepared) { return tangent_map(prepared, options); },
+      [](const nlohmann::ordered_json& result) {
+        fmt::print(results(), "q1 = [{}]\np1 = [{}]\nd(q1, p1)/d(q0, p0) =\n",
+                   fmt::join(result["q1"].get<std::vector<double>>(), ", "),
+                   fmt::join(result["p1"].get<std::vector<double>>(), ", "));
+        const int d = static_cast<int>(result["jacobian"].size());
+        Eigen::MatrixXd M(d, d);
+        for (int r = 0; r < d; ++r) {
+          const auto row = result["jacobian"][r].get<std::vector<double>>();
+          fmt::print(results(), "  {:>24.16e}\n", fmt::join(row, " "));
+          for (int c = 0; c < d; ++c) M(r, c) = row[c];
+        }
+        fmt::print(results(), "symplecticity defect max |M^T J M - J| = {:.3e}\n", symplecticity_residual(M));
+      });
 }
 
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,

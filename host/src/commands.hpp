@@ -28,6 +28,9 @@ struct CommonOptions {
   std::vector<std::string> settings{};      // --set POINTER=JSON, repeatable (scene.hpp, apply_settings)
 };
 
+// The registry of the bundled plugins and the --plugin-path directories.
+Registry make_registry(const CommonOptions& common);
+
 // Runs a command's body with a registry of its own. A plugin fault, or a non-finite value that a
 // plugin returned, is re-thrown naming the plugin (kind, type, file) of the object that failed: the
 // object carries its plugin record (PluginObject::origin, set by Registry::create) into the fault.

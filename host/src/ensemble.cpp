@@ -2,7 +2,6 @@
 
 #define OMPI_SKIP_MPICXX 1  // the C interface only (Open MPI's deprecated C++ bindings need libmpi_cxx)
 #include <mpi.h>
-#include <unistd.h>
 
 #include <fmt/format.h>
 
@@ -22,6 +21,7 @@
 #include "json_reader.hpp"
 #include "output.hpp"
 #include "plot.hpp"
+#include "progress.hpp"
 #include "registry.hpp"
 #include "run.hpp"
 #include "scene.hpp"
@@ -125,34 +125,6 @@ json member_document(const Plan& plan, long member) {
   return document;
 }
 
-// The members' outcomes, as `varia run` would exit (spec "Exit codes"): the messages of failed ones.
-int exit_code_of(std::exception_ptr failure, std::string& message) {
-  try {
-    std::rethrow_exception(failure);
-  } catch (const InputError& e) {
-    message = e.what();
-    return kExitInput;
-  } catch (const PluginLoadError& e) {
-    message = e.what();
-    return kExitPlugin;
-  } catch (const PluginFault& e) {
-    message = fmt::format("plugin fault: {}", e.what());
-    return kExitPlugin;
-  } catch (const NumericalFailure& e) {
-    message = fmt::format("numerical failure: {}", e.what());
-    return kExitNumerical;
-  } catch (const std::invalid_argument& e) {
-    message = e.what();
-    return kExitInput;
-  } catch (const std::bad_alloc&) {
-    message = "out of memory";
-    return kExitInput;
-  } catch (const std::exception& e) {
-    message = fmt::format("unexpected failure: {}", e.what());
-    return kExitPlugin;
-  }
-}
-
 // One member, run as `varia run` runs its scene, with nothing written: its status, final state and
 // record numbers. Scenes are prepared one at a time (`prepare`: the scene's validators are shared);
 // the runs themselves in parallel. Interrupted propagates (the member is not recorded).
@@ -240,32 +212,6 @@ Plan make_plan(const std::string& scene_file, const CommonOptions& common, const
   return plan;
 }
 
-// "varia: ensemble: 12 of 32 members (37%), about 5 s left" on stderr, when it is a terminal.
-class EnsembleProgress {
- public:
-  EnsembleProgress(long total, bool quiet) : total_(total), active_(!quiet && ::isatty(STDERR_FILENO)) {}
-  ~EnsembleProgress() {
-    if (active_ && shown_) std::fputs("\r\033[K", stderr);
-  }
-  void member_done() {
-    ++done_;
-    const auto now = std::chrono::steady_clock::now();
-    if (!active_ || (shown_ && now - last_ < std::chrono::milliseconds(200))) return;
-    last_ = now;
-    shown_ = true;
-    const double elapsed = std::chrono::duration<double>(now - start_).count();
-    std::fprintf(stderr, "\rvaria: ensemble: %ld of %ld members (%.0f%%), about %.0f s left\033[K", done_, total_,
-                 100.0 * done_ / total_, elapsed / done_ * (total_ - done_));
-    std::fflush(stderr);
-  }
-  long done() const { return done_; }
-
- private:
-  long total_, done_ = 0;
-  bool active_, shown_ = false;
-  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now(), last_;
-};
-
 // A failed member's line on stderr (by the process that ran it).
 void say_failure(const Plan& plan, long member, const MemberResult& r, const std::string& message) {
   if (r.status == 0 || message.empty()) return;
@@ -276,13 +222,11 @@ void say_failure(const Plan& plan, long member, const MemberResult& r, const std
              printable(message));
 }
 
-Registry registry_of(const CommonOptions& common) { return Registry(Registry::search_path(common.plugin_paths)); }
-
 // The members still to run, handed out one at a time (take), and the file their results go to
 // (record), shared by this process's threads and, under mpirun, rank 0's service of the others.
 class Dispatcher {
  public:
-  Dispatcher(const Plan& plan, const std::vector<long>& todo, EnsembleFile& file, EnsembleProgress& progress)
+  Dispatcher(const Plan& plan, const std::vector<long>& todo, EnsembleFile& file, ProgressLine& progress)
       : plan_(plan), todo_(todo), file_(file), progress_(progress) {}
   // The next member, or -1: none left, or an interruption or a failed write stopped the ensemble.
   long take() {
@@ -300,11 +244,11 @@ class Dispatcher {
       return;
     }
     say_failure(plan_, member, r, message);
-    progress_.member_done();
+    progress_.update(++done_);
   }
   // Takes and runs members until none is left, with a registry of its own.
   void work(const CommonOptions& common) {
-    Registry registry = registry_of(common);
+    Registry registry = make_registry(common);
     for (long member; (member = take()) >= 0;) {
       std::string message;
       try {
@@ -320,14 +264,16 @@ class Dispatcher {
     if (failure_) std::rethrow_exception(failure_);
   }
   const Plan& plan() const { return plan_; }
+  long done() const { return done_; }
 
  private:
   const Plan& plan_;
   const std::vector<long>& todo_;
   EnsembleFile& file_;
-  EnsembleProgress& progress_;
+  ProgressLine& progress_;
   std::mutex mutex_, prepare_;
   std::size_t next_ = 0;
+  long done_ = 0;  // members recorded by this command
   std::exception_ptr failure_;
 };
 
@@ -403,7 +349,7 @@ void master(Dispatcher& dispatcher, const CommonOptions& common, int workers) {
 }
 
 void worker(const Plan& plan, const CommonOptions& common) {
-  Registry registry = registry_of(common);
+  Registry registry = make_registry(common);
   std::mutex prepare;
   std::vector<double> message(message_size(plan.layout), std::nan(""));
   message[0] = 0;
@@ -479,7 +425,7 @@ void plot_map(const Plan& plan, const EnsembleFile& file, const std::filesystem:
   write_map_svg(to, map);
 }
 
-int finish(const Plan& plan, EnsembleFile& file, const EnsembleProgress& progress, const EnsembleOptions& options,
+int finish(const Plan& plan, EnsembleFile& file, const Dispatcher& dispatcher, const EnsembleOptions& options,
            double seconds) {
   if (options.plot) plot_map(plan, file, *options.plot);
   file.close();
@@ -487,7 +433,7 @@ int finish(const Plan& plan, EnsembleFile& file, const EnsembleProgress& progres
   for (int s : file.statuses()) run += s >= 0, failed += s > 0;
   if (!options.quiet)
     fmt::print(results(), "ensemble: {} members, {} run now, {} held in all, {} failed; {:.2f} s; {}\n",
-               plan.layout.members, progress.done(), run, failed, seconds, printable(options.out.string()));
+               plan.layout.members, dispatcher.done(), run, failed, seconds, printable(options.out.string()));
   stop_if_interrupted(fmt::format("after {} of {} members; {} holds them, and --resume runs the rest", run,
                                   plan.layout.members, printable(options.out.string())));
   return 0;
@@ -515,11 +461,11 @@ int command_ensemble(const CommonOptions& common, const std::string& scene_file,
     std::vector<long> todo;
     for (long m = 0; m < plan.layout.members; ++m)
       if (file.statuses()[static_cast<std::size_t>(m)] < 0) todo.push_back(m);
-    EnsembleProgress progress(static_cast<long>(todo.size()), options.quiet);
+    ProgressLine progress("member", static_cast<long>(todo.size()), options.quiet);
     Dispatcher dispatcher(plan, todo, file, progress);
     if (distributed) master(dispatcher, common, mpi->size() - 1);
     else run_on_threads(dispatcher, common, options.threads);
-    return finish(plan, file, progress, options,
+    return finish(plan, file, dispatcher, options,
                   std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   });
 }

@@ -61,21 +61,8 @@ std::string read_string_attribute(hid_t file, const char* name) {
   return text;
 }
 
-bool write_string_attribute(hid_t file, const char* name, const std::string& text) {
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  const hid_t space = H5Screate(H5S_SCALAR);
-  hid_t attribute = -1;
-  const bool written = type >= 0 && space >= 0 && H5Tset_size(type, text.size() + 1) >= 0 &&
-                       (attribute = H5Acreate2(file, name, type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0 &&
-                       H5Awrite(attribute, type, text.c_str()) >= 0;
-  if (attribute >= 0) H5Aclose(attribute);
-  if (space >= 0) H5Sclose(space);
-  if (type >= 0) H5Tclose(type);
-  return written;
-}
-
 // One row (member) of a dataset of `width` numbers per row.
-bool write_row(hid_t dataset, hid_t type, bool is_matrix, long row, int width, const void* data) {
+bool write_row(hid_t dataset, hid_t type, bool is_matrix, long row, int width, const void* data, std::string& cause) {
   const int rank = is_matrix ? 2 : 1;
   const hsize_t start[2] = {static_cast<hsize_t>(row), 0}, count[2] = {1, static_cast<hsize_t>(width)};
   const hid_t file_space = H5Dget_space(dataset);
@@ -83,6 +70,7 @@ bool write_row(hid_t dataset, hid_t type, bool is_matrix, long row, int width, c
   const bool written = file_space >= 0 && memory_space >= 0 &&
                        H5Sselect_hyperslab(file_space, H5S_SELECT_SET, start, nullptr, count, nullptr) >= 0 &&
                        H5Dwrite(dataset, type, memory_space, file_space, H5P_DEFAULT, data) >= 0;
+  if (!written) cause = hdf5_cause();  // before the calls below clear the library's error stack
   if (memory_space >= 0) H5Sclose(memory_space);
   if (file_space >= 0) H5Sclose(file_space);
   return written;
@@ -93,8 +81,7 @@ bool write_row(hid_t dataset, hid_t type, bool is_matrix, long row, int width, c
 EnsembleFile::EnsembleFile(const fs::path& file, const std::string& scene_text, const std::string& vary_text,
                            const EnsembleLayout& layout, const std::vector<double>& parameters, bool resume)
     : name_(file.string()), layout_(layout), h_(std::make_unique<Handles>()) {
-  H5dont_atexit();
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+  take_over_hdf5();
   const bool existing = resume && fs::exists(file);
   staged_ = std::make_unique<StagedFile>(file, "--out");
   if (existing) open_copy(scene_text, vary_text);
@@ -109,16 +96,12 @@ void EnsembleFile::fail(const std::string& doing, const std::string& cause) {
 
 void EnsembleFile::create(const std::string& scene_text, const std::string& vary_text,
                           const std::vector<double>& parameters) {
-  const hid_t creation = H5Pcreate(H5P_FILE_CREATE), access = H5Pcreate(H5P_FILE_ACCESS);
-  if (creation >= 0 && access >= 0 && H5Pset_attr_phase_change(creation, 0, 0) >= 0 &&
-      H5Pset_libver_bounds(access, H5F_LIBVER_V18, H5F_LIBVER_V18) >= 0)
-    h_->file = H5Fcreate(staged_->temporary().c_str(), H5F_ACC_TRUNC, creation, access);
-  const std::string cause = h_->file < 0 ? hdf5_cause() : "";
-  if (access >= 0) H5Pclose(access);
-  if (creation >= 0) H5Pclose(creation);
+  std::string cause;
+  h_->file = create_hdf5_file(staged_->temporary(), cause);
   if (h_->file < 0) fail("created", cause);
-  if (!write_string_attribute(h_->file, "scene", scene_text) || !write_string_attribute(h_->file, "vary", vary_text))
-    fail("given its attributes", hdf5_cause());
+  if (!write_string_attribute(h_->file, "scene", scene_text, cause) ||
+      !write_string_attribute(h_->file, "vary", vary_text, cause))
+    fail("given its attributes", cause);
   const auto names = dataset_names(layout_);
   for (std::size_t d = 0; d < names.size(); ++d) {
     const hsize_t dims[2] = {static_cast<hsize_t>(layout_.members), static_cast<hsize_t>(width_of(layout_, d))};
@@ -175,15 +158,16 @@ void EnsembleFile::open_copy(const std::string& scene_text, const std::string& v
 
 void EnsembleFile::write(long member, const MemberResult& r) {
   const std::int32_t status = r.status;
-  bool written = write_row(h_->datasets[1], H5T_NATIVE_INT32, false, member, 1, &status) &&
-                 write_row(h_->datasets[2], H5T_NATIVE_DOUBLE, false, member, 1, &r.t);
+  std::string cause;
+  bool written = write_row(h_->datasets[1], H5T_NATIVE_INT32, false, member, 1, &status, cause) &&
+                 write_row(h_->datasets[2], H5T_NATIVE_DOUBLE, false, member, 1, &r.t, cause);
   if (written && static_cast<int>(r.q.size()) == layout_.point_size)
-    written = write_row(h_->datasets[3], H5T_NATIVE_DOUBLE, true, member, layout_.point_size, r.q.data());
+    written = write_row(h_->datasets[3], H5T_NATIVE_DOUBLE, true, member, layout_.point_size, r.q.data(), cause);
   if (written && static_cast<int>(r.p.size()) == layout_.dim)
-    written = write_row(h_->datasets[4], H5T_NATIVE_DOUBLE, true, member, layout_.dim, r.p.data());
+    written = write_row(h_->datasets[4], H5T_NATIVE_DOUBLE, true, member, layout_.dim, r.p.data(), cause);
   for (std::size_t k = 0; written && k < r.numbers.size(); ++k)
-    written = write_row(h_->datasets[5 + k], H5T_NATIVE_DOUBLE, false, member, 1, &r.numbers[k]);
-  if (!written) fail(fmt::format("written (member {})", member), hdf5_cause());
+    written = write_row(h_->datasets[5 + k], H5T_NATIVE_DOUBLE, false, member, 1, &r.numbers[k], cause);
+  if (!written) fail(fmt::format("written (member {})", member), cause);
   statuses_[static_cast<std::size_t>(member)] = r.status;
 }
 

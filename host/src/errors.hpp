@@ -1,6 +1,7 @@
 // The host's error classes and the exit codes they map to (spec: "Exit codes").
 #pragma once
 
+#include <exception>
 #include <stdexcept>
 #include <string>
 
@@ -33,5 +34,11 @@ inline constexpr int kExitOk = 0;
 inline constexpr int kExitInput = 2;
 inline constexpr int kExitPlugin = 3;
 inline constexpr int kExitNumerical = 4;
+
+// The exit code of a command that ended with `failure` (an InputError 2, a plugin fault 3, a
+// numerical failure 4, ...), and its message: `varia`'s own (cli.cpp) and each ensemble member's
+// status, which is the exit code its own `varia run` would have had. Rethrows an exception that is
+// not a std::exception.
+int exit_code_of(std::exception_ptr failure, std::string& message);
 
 }  // namespace varia::host

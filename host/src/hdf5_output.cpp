@@ -61,12 +61,40 @@ Hdf5Writer::Lock::~Lock() {
   if (fd_ >= 0) ::close(fd_);
 }
 
+void take_over_hdf5() {
+  H5dont_atexit();
+  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);
+}
+
+long long create_hdf5_file(const std::string& path, std::string& cause) {
+  const hid_t creation = H5Pcreate(H5P_FILE_CREATE), access = H5Pcreate(H5P_FILE_ACCESS);
+  hid_t file = -1;
+  if (creation >= 0 && access >= 0 && H5Pset_attr_phase_change(creation, 0, 0) >= 0 &&
+      H5Pset_libver_bounds(access, H5F_LIBVER_V18, H5F_LIBVER_V18) >= 0)
+    file = H5Fcreate(path.c_str(), H5F_ACC_TRUNC, creation, access);
+  if (file < 0) cause = hdf5_cause();  // before the calls below clear the library's error stack
+  if (access >= 0) H5Pclose(access);
+  if (creation >= 0) H5Pclose(creation);
+  return file;
+}
+
+bool write_string_attribute(long long id, const char* name, const std::string& text, std::string& cause) {
+  const hid_t type = H5Tcopy(H5T_C_S1);
+  const hid_t space = H5Screate(H5S_SCALAR);
+  hid_t attribute = -1;
+  const bool written = type >= 0 && space >= 0 && H5Tset_size(type, text.size() + 1) >= 0 &&
+                       (attribute = H5Acreate2(id, name, type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0 &&
+                       H5Awrite(attribute, type, text.c_str()) >= 0;
+  if (!written) cause = hdf5_cause();  // before the calls below clear the library's error stack
+  if (attribute >= 0) H5Aclose(attribute);
+  if (space >= 0) H5Sclose(space);
+  if (type >= 0) H5Tclose(type);
+  return written;
+}
+
 Hdf5Writer::Hdf5Writer(const std::filesystem::path& file, const std::string& scene_text)
     : name_(file.string()), lock_(file), staged_(file, "--out") {
-  // No clean-up of the library at exit: it would flush a file whose write failed again (and HDF5
-  // 1.10 crashes closing it); every file is closed here, or abandoned.
-  H5dont_atexit();
-  H5Eset_auto2(H5E_DEFAULT, nullptr, nullptr);  // errors are reported here, not printed by the library
+  take_over_hdf5();
   try {
     create_file(scene_text);
   } catch (const OutputError&) {
@@ -77,28 +105,12 @@ Hdf5Writer::Hdf5Writer(const std::filesystem::path& file, const std::string& sce
   watch_trajectory(this);
 }
 
-// The file, its root's attributes stored densely (a scene beyond 64 KiB fits), and the `scene`
-// attribute, flushed.
+// The file and its `scene` attribute, flushed.
 void Hdf5Writer::create_file(const std::string& scene_text) {
-  const hid_t creation = H5Pcreate(H5P_FILE_CREATE), access = H5Pcreate(H5P_FILE_ACCESS);
-  if (creation >= 0 && access >= 0 && H5Pset_attr_phase_change(creation, 0, 0) >= 0 &&
-      H5Pset_libver_bounds(access, H5F_LIBVER_V18, H5F_LIBVER_V18) >= 0)
-    file_ = H5Fcreate(staged_.temporary().c_str(), H5F_ACC_TRUNC, creation, access);
-  const std::string created = file_ < 0 ? hdf5_cause() : "";
-  if (access >= 0) H5Pclose(access);
-  if (creation >= 0) H5Pclose(creation);
-  if (file_ < 0) fail("created", created);
-  const hid_t type = H5Tcopy(H5T_C_S1);
-  const hid_t space = H5Screate(H5S_SCALAR);
-  hid_t attribute = -1;
-  const bool written = type >= 0 && space >= 0 && H5Tset_size(type, scene_text.size() + 1) >= 0 &&
-                       (attribute = H5Acreate2(file_, "scene", type, space, H5P_DEFAULT, H5P_DEFAULT)) >= 0 &&
-                       H5Awrite(attribute, type, scene_text.c_str()) >= 0;
-  const std::string cause = written ? "" : hdf5_cause();
-  if (attribute >= 0) H5Aclose(attribute);
-  if (space >= 0) H5Sclose(space);
-  if (type >= 0) H5Tclose(type);
-  if (!written) fail("given the scene attribute", cause);
+  std::string cause;
+  file_ = create_hdf5_file(staged_.temporary(), cause);
+  if (file_ < 0) fail("created", cause);
+  if (!write_string_attribute(file_, "scene", scene_text, cause)) fail("given the scene attribute", cause);
   if (H5Fflush(file_, H5F_SCOPE_GLOBAL) < 0) fail("flushed", hdf5_cause());
 }
 

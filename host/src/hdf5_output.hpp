@@ -26,6 +26,17 @@ namespace varia::host {
 // other call into the library, which clears its error stack.
 std::string hdf5_cause();
 
+// The process's use of the library: no clean-up at exit (it would flush a file whose write failed
+// again, and HDF5 1.10 crashes closing it; every file is closed by its writer, or abandoned), and
+// no error printing by the library (errors are reported by the writers, with hdf5_cause()).
+void take_over_hdf5();
+// A new file at `path` (truncated), its root's attributes stored densely (a text of any size
+// fits), in the file format of HDF5 1.8; -1 on failure, with HDF5's `cause`.
+long long create_hdf5_file(const std::string& path, std::string& cause);
+// The string attribute `name` = `text` of the object `id` (the root: the file); false on failure,
+// with HDF5's `cause`.
+bool write_string_attribute(long long id, const char* name, const std::string& text, std::string& cause);
+
 class Hdf5Writer final : public CrashSafeOutput {
  public:
   // Refuses (OutputError) a file that another run is writing or a program holds open through HDF5

@@ -1,7 +1,6 @@
 #include "run.hpp"
 
 #include <fmt/format.h>
-#include <unistd.h>
 
 #include <algorithm>
 #include <chrono>
@@ -16,6 +15,7 @@
 #include "hdf5_output.hpp"
 #include "output.hpp"
 #include "plot.hpp"
+#include "progress.hpp"
 #include "registry.hpp"
 #include "varia/core/trajectory.hpp"
 
@@ -30,29 +30,6 @@ using Clock = std::chrono::steady_clock;
 // The longest stretch of unobserved steps taken without a look at the interruption flag and the
 // progress line: a fraction of a second for a step of a millisecond.
 constexpr long kStretch = 256;
-
-// A progress line on stderr, only when stderr is a terminal (spec: "Progress and diagnostics").
-class Progress {
- public:
-  Progress(long steps, bool quiet) : steps_(steps), active_(!quiet && ::isatty(STDERR_FILENO)) {}
-  ~Progress() {
-    if (active_ && shown_) std::fputs("\r\033[K", stderr);
-  }
-  void update(long step) {
-    if (!active_) return;
-    const auto now = Clock::now();
-    if (shown_ && now - last_ < std::chrono::milliseconds(200)) return;
-    last_ = now;
-    shown_ = true;
-    std::fprintf(stderr, "\rvaria: step %ld of %ld (%.0f%%)", step, steps_, 100.0 * step / steps_);
-    std::fflush(stderr);
-  }
-
- private:
-  long steps_;
-  bool active_, shown_ = false;
-  Clock::time_point last_;
-};
 
 std::vector<std::string> csv_columns(int point_size, int dim, const Observer& observer) {
   std::vector<std::string> columns{"t"};
@@ -253,7 +230,7 @@ class Stepper {
 
   // Runs every step; returns the failure that stopped it, if any.
   std::optional<Failure> run(bool quiet) {
-    Progress progress(scene_.steps, quiet);
+    ProgressLine progress("step", scene_.steps, quiet);
     const auto start = Clock::now();
     std::optional<Failure> failure;
     try {

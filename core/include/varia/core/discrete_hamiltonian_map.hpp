@@ -56,6 +56,7 @@ class DiscreteHamiltonianMap {
   // tangent_map_refusal() is not empty.
   void step_with_tangent(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
                          const double* directions, double* images) {
+    if (const std::string refusal = tangent_map_refusal(); !refusal.empty()) throw std::logic_error(refusal);
     take_tangent_step(q0, p0, t0, h, q1, p1, count, directions, images);
   }
   // Empty where the map has its tangent map; else why it has none (the host refuses a scene that
@@ -65,11 +66,10 @@ class DiscreteHamiltonianMap {
   virtual const EvaluationCounters& evaluations() const = 0;
 
  protected:
+  // Called only where tangent_map_refusal() is empty.
   virtual void take_tangent_step(const double* /*q0*/, const double* /*p0*/, double /*t0*/, double /*h*/,
                                  double* /*q1*/, double* /*p1*/, int /*count*/, const double* /*directions*/,
-                                 double* /*images*/) {
-    throw std::logic_error(tangent_map_refusal());
-  }
+                                 double* /*images*/) {}
   virtual void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) = 0;
   // The default takes one step after another, step k from t0 + k h (a product, not a sum: no
   // round-off accumulates in the time). A map may override it to keep its state in registers
