@@ -170,7 +170,7 @@ Eigen::MatrixXd GalerkinDiscreteLagrangian::extrapolation_to_nodes(const std::ve
   return E;
 }
 
-// A constant mass matrix, no forces (f(v) would add to the kinetic part), a dense Jacobian; M
+// A constant mass matrix, no forces (f(v) would add to the kinetic part); a dense Lagrangian's M
 // symmetric positive definite (the Lagrangian hyperregular), and the stiffness matrix's block for
 // the step's equations invertible (it is: K's kernel is the constants, and its rows sum to 0).
 // The maps (see the top of galerkin.hpp): with the forces g_j at the R nodes of nonzero weight
@@ -181,12 +181,17 @@ Eigen::MatrixXd GalerkinDiscreteLagrangian::extrapolation_to_nodes(const std::ve
 //   P_muj = -b_j sum_nu (K^{-1})_{mu nu} l_nu(c_j),   u0 = M^{-1} p0,
 // and the nodes' offsets are the interpolant's there, sum_mu l_mu(c_i) X^mu.
 bool GalerkinDiscreteLagrangian::simplified_applies() {
-  if (!forces_.empty() || lagrangian_.sparse()) return false;
-  mass_matrix_.resize(n_, n_);
-  if (!lagrangian_.plugin().constant_mass_matrix(mass_matrix_.data())) return false;
-  const Eigen::LLT<Eigen::MatrixXd> mass(mass_matrix_);
-  if (mass.info() != Eigen::Success) return false;
-  inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
+  if (!forces_.empty()) return false;
+  if (lagrangian_.sparse()) {
+    // M from the Hessian's velocity block, factorized at the first step (inverse_mass_times)
+    if (!lagrangian_.plugin().has_constant_mass_matrix()) return false;
+  } else {
+    mass_matrix_.resize(n_, n_);
+    if (!lagrangian_.plugin().constant_mass_matrix(mass_matrix_.data())) return false;
+    const Eigen::LLT<Eigen::MatrixXd> mass(mass_matrix_);
+    if (mass.info() != Eigen::Success) return false;
+    inverse_mass_ = mass.solve(Eigen::MatrixXd::Identity(n_, n_));
+  }
   // In long double (64-bit mantissa on x86, else double): K's block is ill-conditioned at larger s,
   // and a map's rounding is a change of the method, the same at every step (bench/README.md,
   // "Measured design choices").
@@ -231,7 +236,6 @@ bool GalerkinDiscreteLagrangian::simplified_applies() {
 // nodes' accelerations from the last steps, once the maps are formed.
 void GalerkinDiscreteLagrangian::prepare_node_iteration() {
   const int R = static_cast<int>(iteration_nodes_.size());
-  mass_norm_ = mass_matrix_.cwiseAbs().rowwise().sum().maxCoeff();
   end_map_ = control_map_.bottomRows(1);
   velocity0_.resize(n_);
   for (Eigen::VectorXd* v : {&node_offsets_, &next_offsets_, &node_accelerations_, &predicted_accelerations_})

@@ -181,6 +181,9 @@ void GalerkinDiscreteLagrangian::factorize_sparse_mass(const double* q) {
   const std::vector<Eigen::Triplet<double>> triplets = mass_entries(q);
   sparse_mass_.resize(n_, n_);
   sparse_mass_.setFromTriplets(triplets.begin(), triplets.end());
+  diagonal_mass_ = sparse_mass_.nonZeros() == n_;
+  for (int k = 0; k < n_ && diagonal_mass_; ++k)
+    diagonal_mass_ = sparse_mass_.outerIndexPtr()[k] == k && sparse_mass_.innerIndexPtr()[k] == k;
   sparse_mass_solver_.compute(sparse_mass_);
   if (sparse_mass_solver_.info() != Eigen::Success)
     throw NumericalFailure("the Lagrangian's constant mass matrix (its Hessian's velocity block) is not positive "

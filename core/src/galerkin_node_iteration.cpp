@@ -68,19 +68,20 @@ template <int N, int Rows, int C>
 // The fixed point's residual at the nodes' offsets D (node_offsets_): the forces g_j = dL/dq at
 // q0 + D_j in one plugin call (Lagrangian::gradients; v = 0: for this Lagrangian L_q does not
 // depend on v), kept with M^{-1} g_j, the offsets D' that the step's equations give for those
-// forces (into next_offsets_), and F = M (D - D') / h (R n), with 1/h and |p0| given (once a step). F is the equations' residual in their
-// own units, momentum (at X, with X' the control points of D', the residual of equation nu is
-// (1/h) M sum_mu K_numu (X^mu - X'^mu)): the stopping rule's tolerance means what it means for
-// the equations, and its yardstick is theirs, |p0| and the kinetic terms |M D'| / h. (The
-// offsets' difference itself is smaller by h / |M|: at tolerance (1 + yardstick) in positions the
-// rule stopped with systematic errors h^-1 times larger; bench/README.md, "Measured design choices".)
+// forces (into next_offsets_), and F = (D - D') / (h w) (R n), with 1/h and |u0| given (once a
+// step). (D - D') / h is M^{-1} times the equations' residual (at X, with X' the control points of
+// D', the residual of equation nu is (1/h) M sum_mu K_numu (X^mu - X'^mu)): in velocity units every
+// coordinate counts alike whatever its mass. w, its yardstick, is the size of the velocities the
+// equations sum, |u0| and |D'| / h, so F is relative and the stopping rule means the same in any
+// system of units (in momentum units with the solver's tolerance (1 + yardstick), the outer solar
+// system's planets, in days, AU and solar masses, stopped tens of eps short of the fixed point:
+// bench/README.md, "Measured design choices").
 template <int N, int R>
-[[gnu::always_inline]] inline double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, double momentum,
+[[gnu::always_inline]] inline double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, double speed,
                                                                                double* __restrict F) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
   const double* __restrict q0 = origin_.data();
   const double* __restrict D = node_offsets_.data();
-  const double* __restrict M = mass_matrix_.data();
   const double* __restrict M_inverse = inverse_mass_.data();
   double* __restrict z = node_points_.data();
   double* __restrict gradients = node_gradients_.data();
@@ -91,6 +92,10 @@ template <int N, int R>
   lagrangian_.gradients(nodes, z, gradients);
   for (int j = 0; j < nodes; ++j) {
     const double* g = gradients + 2 * n * j;
+    if (sparse_mass_.rows() > 0) {
+      inverse_mass_times(g, accelerations + j * n);
+      continue;
+    }
     for (int c = 0; c < n; ++c) {
       double a = 0.0;
       for (int d = 0; d < n; ++d) a += M_inverse[c + d * n] * g[d];
@@ -99,14 +104,31 @@ template <int N, int R>
   }
   offsets_from_forces<N, R, R>(node_map_, h, accelerations, next);
   double largest = 0.0;
-  for (int j = 0; j < nodes; ++j)
-    for (int c = 0; c < n; ++c) {
-      double f = 0.0;
-      for (int d = 0; d < n; ++d) f += M[c + d * n] * (D[j * n + d] - next[j * n + d]);
-      F[j * n + c] = f * inverse_h;
-      largest = std::max(largest, std::abs(next[j * n + c]));
-    }
-  return std::max(momentum, mass_norm_ * largest * inverse_h);
+  for (int k = 0; k < nodes * n; ++k) largest = std::max(largest, std::abs(next[k]));
+  const double yardstick = std::max(speed, largest * inverse_h);
+  const double scale = yardstick > 0.0 ? inverse_h / yardstick : inverse_h;
+  for (int k = 0; k < nodes * n; ++k) F[k] = (D[k] - next[k]) * scale;
+  return 0.0;
+}
+
+// a = M^{-1} g (n numbers each, apart): by M^{-1}, or by the sparse Cholesky factor of M, in
+// place (natural order: no permutation, no temporary). A sparse M is factorized at the first step
+// (solve_at_nodes); before it, the action's accelerations (used by steps only) are not formed.
+void GalerkinDiscreteLagrangian::inverse_mass_times(const double* g, double* a) {
+  Eigen::Map<Eigen::VectorXd> x(a, n_);
+  const Eigen::Map<const Eigen::VectorXd> b(g, n_);
+  if (!lagrangian_.sparse()) {
+    x.noalias() = inverse_mass_ * b;
+    return;
+  }
+  if (sparse_mass_.rows() == 0) return;
+  if (diagonal_mass_) {  // particles: one rounding, g / m
+    x.array() = b.array() / sparse_mass_.coeffs().array();
+    return;
+  }
+  x = b;
+  sparse_mass_solver_.matrixL().solveInPlace(x);
+  sparse_mass_solver_.matrixU().solveInPlace(x);
 }
 
 // The fixed point D = D'(g(q0 + D)) as a NewtonSolver system with the Jacobian M / h at every node
@@ -117,11 +139,11 @@ template <int N, int R>
 struct GalerkinDiscreteLagrangian::NodeIteration {
   GalerkinDiscreteLagrangian& g;
   double h, inverse_h;
-  double momentum, origin;  // |p0|, |q0|
+  double speed, origin;  // |u0|, |q0|
 
   int size() const { return static_cast<int>(g.node_offsets_.size()); }
   bool simplified() const { return true; }
-  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.node_residual<N, R>(h, inverse_h, momentum, F.data()); }
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.node_residual<N, R>(h, inverse_h, speed, F.data()); }
   void factorize() {}
   void solve(const Eigen::VectorXd&, Eigen::VectorXd& update) {
     const int size = fixed_or<R>(static_cast<int>(g.iteration_nodes_.size())) * fixed_or<N>(g.n_);
@@ -147,12 +169,11 @@ struct GalerkinDiscreteLagrangian::NodeIteration {
 template <int N, int R>
 bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool continues) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
-  double momentum = 0.0, origin = 0.0;
+  if (lagrangian_.sparse() && sparse_mass_.rows() == 0) factorize_sparse_mass(origin_.data());
+  inverse_mass_times(p0, velocity0_.data());
+  double speed = 0.0, origin = 0.0;
   for (int c = 0; c < n; ++c) {
-    double u = 0.0;
-    for (int d = 0; d < n; ++d) u += inverse_mass_.data()[c + d * n] * p0[d];
-    velocity0_[c] = u;
-    momentum = std::max(momentum, std::abs(p0[c]));
+    speed = std::max(speed, std::abs(velocity0_[c]));
     origin = std::max(origin, std::abs(origin_[c]));
   }
   if (continues) {
@@ -163,7 +184,7 @@ bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool
     for (int j = 0; j < nodes; ++j)
       for (int c = 0; c < n; ++c) node_offsets_[j * n + c] = nodes_[iteration_nodes_[j]] * h * velocity0_[c];
   }
-  NodeIteration<N, R> iteration{*this, h, 1.0 / h, momentum, origin};
+  NodeIteration<N, R> iteration{*this, h, 1.0 / h, speed, origin};
   if (!solver_.solve(iteration, statistics_).converged()) return false;
   offsets_from_forces<N, 1, R>(end_map_, h, node_accelerations_.data(), points_.col(s_).data());
   for (int c = 0; c < n; ++c) {

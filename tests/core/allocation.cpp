@@ -112,6 +112,17 @@ TEST_CASE("galerkin's explicit form for a sparse Lagrangian allocates nothing pe
   CHECK(verlet.solver_statistics().max_iterations == 0);
 }
 
+TEST_CASE("galerkin's node iteration for a sparse Lagrangian (its diagonal mass matrix) allocates nothing per step") {
+  const int n = 5;
+  FlatSpace space(n);
+  SparseChain chain(n, true);
+  auto rule = lobatto3();
+  GalerkinDiscreteLagrangian galerkin(space, chain, rule, equispaced_control_times(2), {});
+  CHECK(allocations_of_steps(galerkin, n) == 0);
+  CHECK(galerkin.evaluations().hessian == 1);  // M read once off the Hessian; then gradients only
+  CHECK(galerkin.solver_statistics().iterations > 0);
+}
+
 // SO(3) through the SDK's generic adapter (no tuned chart): each simplified Newton iteration asks
 // the chart for first derivatives only, at first-order duals on the stack.
 class AdapterRotations final : public sdk::LieGroupManifold<sdk::groups::Rotations> {

@@ -205,7 +205,8 @@ TEST_CASE("SIGINT, SIGTERM and SIGHUP end a run with whole rows, a run record no
 TEST_CASE("SIGTERM ends verify between its measurements, exit 143, no --json written") {
   TempDir dir;
   // A verify of many seconds, each of its measurements far shorter.
-  const pid_t pid = start_varia({"verify", "scenes/morse-chain.json", "--json", (dir / "v.json").string()}, dir);
+  const pid_t pid =
+      start_varia({"verify", "scenes/multibody/rod-chain-100.json", "--json", (dir / "v.json").string()}, dir);
   REQUIRE(pid > 0);
   std::this_thread::sleep_for(std::chrono::seconds(2));  // loaded and measuring
   const auto signalled = std::chrono::steady_clock::now();

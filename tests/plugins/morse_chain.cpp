@@ -95,7 +95,7 @@ TEST_CASE("morse-chain at 30 particles (60 DOF) gives L, the gradient and the He
 }
 
 TEST_CASE("Galerkin on the 60-DOF morse chain: the term-wise plugin and the dense model take the same steps, "
-          "Newton converges quadratically") {
+          "by the node iteration (a constant mass matrix), which contracts") {
   MorseChainParameters p;
   const auto chain = plugin_chain(p);
   varia::testing::DenseMorseChain dense(p);
@@ -103,18 +103,19 @@ TEST_CASE("Galerkin on the 60-DOF morse chain: the term-wise plugin and the dens
   const double h = 0.05;
   const Run termwise = galerkin(*chain, p, h, steps);
   const Run one_model = galerkin(dense, p, h, steps);
-  MESSAGE("60 DOF, degree 2, Lobatto 3, h = " << h << ": Newton iterations per step " << termwise.newton_mean
+  MESSAGE("60 DOF, degree 2, Lobatto 3, h = " << h << ": iterations per step " << termwise.newton_mean
                                               << "; time per step: term-wise " << 1e6 * termwise.seconds_per_step
                                               << " us, dense " << 1e6 * one_model.seconds_per_step << " us");
   CHECK((termwise.state - one_model.state).lpNorm<Eigen::Infinity>() <= 1e-12);
-  // Quadratic convergence: each residual above round-off is at most about the square of the one before.
+  // The fixed-point iteration in the nodes' positions (relative residuals) contracts: each residual
+  // above round-off is at most a tenth of the one before (theta ~ h^2 times the bonds' stiffness).
   const auto& r = termwise.last_residuals;
   std::ostringstream residuals;
   for (double x : r) residuals << " " << x;
-  MESSAGE("the last step's Newton residuals:" << residuals.str());
+  MESSAGE("the last step's residuals:" << residuals.str());
   REQUIRE(r.size() >= 2);
   for (std::size_t k = 1; k < r.size(); ++k)
-    if (r[k] > 1e-13) CHECK(r[k] <= 10 * r[k - 1] * r[k - 1]);
+    if (r[k] > 1e-13) CHECK(r[k] <= 0.1 * r[k - 1]);
 }
 
 TEST_CASE("shooting on the 60-DOF morse chain (rk4 + Simpson, lagrangian form, the sensitivities in passes of "

@@ -169,7 +169,8 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N, int R>
   struct NodeIteration;
   template <int N, int R>
-  double node_residual(double h, double inverse_h, double momentum, double* F);
+  double node_residual(double h, double inverse_h, double speed, double* F);
+  void inverse_mass_times(const double* g, double* a);
   template <int N, int R>
   bool solve_at_nodes(const double* p0, double h, bool continues);
   void predict_accelerations();
@@ -264,7 +265,8 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // from there: one gradient evaluation per step).
   AdvanceFunction explicit_advance_ = nullptr;
   StepFunction step_ = nullptr;  // every other step: step_at<N, R>, chosen once
-  // Simplified Newton in the nodes' coordinates (constant mass matrix). M^{-1} (inverse_mass_);
+  // Simplified Newton in the nodes' coordinates (constant mass matrix). M^{-1} (inverse_mass_, or
+  // a sparse M's factor, sparse_mass_solver_);
   // the velocity u0 = M^{-1} p0 of the step; the maps from (u0, the forces' M^{-1} g_i) to offsets
   // (see offsets_from_forces): to the nodes' (node_map_, R x (1 + R)) and to the control points'
   // q^1..q^s (control_map_, s x (1 + R); end_map_ its last row, q1's); the indices of the nodes of
@@ -287,7 +289,6 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Eigen::PartialPivLU<Eigen::MatrixXd> tangent_lu_;
   Eigen::MatrixXd tangent_rhs_, tangent_points_;
   Eigen::MatrixXd node_map_, control_map_, end_map_, prediction_map_[2];
-  double mass_norm_ = 0.0;  // |M|_inf
   std::vector<int> iteration_nodes_;
   Eigen::VectorXd velocity0_, node_offsets_, next_offsets_, node_accelerations_, predicted_accelerations_;
   Eigen::VectorXd node_points_, node_gradients_;
@@ -295,7 +296,8 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   bool two_steps_back_ = false;
   double b0_ = 0.0, b1_ = 0.0;
   Eigen::MatrixXd mass_matrix_, inverse_mass_;
-  Eigen::SparseMatrix<double> sparse_mass_;  // the sparse explicit form's M, and its Cholesky factor
+  Eigen::SparseMatrix<double> sparse_mass_;  // a sparse Lagrangian's constant M, and its Cholesky factor
+  bool diagonal_mass_ = false;  // sparse_mass_ is diagonal: its coefficients are M's diagonal, in order
   Eigen::SimplicialLLT<Eigen::SparseMatrix<double>, Eigen::Lower, Eigen::NaturalOrdering<int>> sparse_mass_solver_;
   Eigen::VectorXd force_, increment_, last_q_, last_p_;
   bool has_force_ = false;
