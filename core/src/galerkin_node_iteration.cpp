@@ -69,7 +69,9 @@ template <int N, int Rows, int C>
 // q0 + D_j in one plugin call (Lagrangian::gradients; v = 0: for this Lagrangian L_q does not
 // depend on v), kept with M^{-1} g_j, the offsets D' that the step's equations give for those
 // forces (into next_offsets_), and F = (D - D') / (h w) (R n), with 1/h and |u0| given (once a
-// step). (D - D') / h is M^{-1} times the equations' residual (at X, with X' the control points of
+// step), and 1 / (h w) formed at the solve's first evaluation (`scale`, 0 until then: the iterates
+// change w by less than the warm start's error, and a division per pass lengthens the chain from
+// one pass to the next). (D - D') / h is M^{-1} times the equations' residual (at X, with X' the control points of
 // D', the residual of equation nu is (1/h) M sum_mu K_numu (X^mu - X'^mu)): in velocity units every
 // coordinate counts alike whatever its mass. w, its yardstick, is the size of the velocities the
 // equations sum, |u0| and |D'| / h, so F is relative and the stopping rule means the same in any
@@ -78,7 +80,7 @@ template <int N, int Rows, int C>
 // bench/README.md, "Measured design choices").
 template <int N, int R>
 [[gnu::always_inline]] inline double GalerkinDiscreteLagrangian::node_residual(double h, double inverse_h, double speed,
-                                                                               double* __restrict F) {
+                                                                               double& scale, double* __restrict F) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
   const double* __restrict q0 = origin_.data();
   const double* __restrict D = node_offsets_.data();
@@ -103,10 +105,12 @@ template <int N, int R>
     }
   }
   offsets_from_forces<N, R, R>(node_map_, h, accelerations, next);
-  double largest = 0.0;
-  for (int k = 0; k < nodes * n; ++k) largest = std::max(largest, std::abs(next[k]));
-  const double yardstick = std::max(speed, largest * inverse_h);
-  const double scale = yardstick > 0.0 ? inverse_h / yardstick : inverse_h;
+  if (scale == 0.0) {
+    double largest = 0.0;
+    for (int k = 0; k < nodes * n; ++k) largest = std::max(largest, std::abs(next[k]));
+    const double yardstick = std::max(speed, largest * inverse_h);
+    scale = yardstick > 0.0 ? inverse_h / yardstick : inverse_h;
+  }
   for (int k = 0; k < nodes * n; ++k) F[k] = (D[k] - next[k]) * scale;
   return 0.0;
 }
@@ -140,10 +144,11 @@ struct GalerkinDiscreteLagrangian::NodeIteration {
   GalerkinDiscreteLagrangian& g;
   double h, inverse_h;
   double speed, origin;  // |u0|, |q0|
+  double scale = 0.0;     // 1 / (h w), node_residual's
 
   int size() const { return static_cast<int>(g.node_offsets_.size()); }
   bool simplified() const { return true; }
-  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.node_residual<N, R>(h, inverse_h, speed, F.data()); }
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) { return g.node_residual<N, R>(h, inverse_h, speed, scale, F.data()); }
   void factorize() {}
   void solve(const Eigen::VectorXd&, Eigen::VectorXd& update) {
     const int size = fixed_or<R>(static_cast<int>(g.iteration_nodes_.size())) * fixed_or<N>(g.n_);
@@ -169,8 +174,16 @@ struct GalerkinDiscreteLagrangian::NodeIteration {
 template <int N, int R>
 bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool continues) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
-  if (lagrangian_.sparse() && sparse_mass_.rows() == 0) factorize_sparse_mass(origin_.data());
-  inverse_mass_times(p0, velocity0_.data());
+  if (lagrangian_.sparse()) {
+    if (sparse_mass_.rows() == 0) factorize_sparse_mass(origin_.data());
+    inverse_mass_times(p0, velocity0_.data());
+  } else {
+    for (int c = 0; c < n; ++c) {
+      double u = 0.0;
+      for (int d = 0; d < n; ++d) u += inverse_mass_.data()[c + d * n] * p0[d];
+      velocity0_[c] = u;
+    }
+  }
   double speed = 0.0, origin = 0.0;
   for (int c = 0; c < n; ++c) {
     speed = std::max(speed, std::abs(velocity0_[c]));

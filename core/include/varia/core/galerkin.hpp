@@ -169,7 +169,7 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N, int R>
   struct NodeIteration;
   template <int N, int R>
-  double node_residual(double h, double inverse_h, double speed, double* F);
+  double node_residual(double h, double inverse_h, double speed, double& scale, double* F);
   void inverse_mass_times(const double* g, double* a);
   template <int N, int R>
   bool solve_at_nodes(const double* p0, double h, bool continues);
