@@ -157,16 +157,24 @@ void define_run(CLI::App& app, Options& o, Command& chosen) {
   });
 }
 
+// The options of a command at one point (ld, tangent): the scene, --q0, a second vector (`second`:
+// q1 or p0), --h and --json.
+void add_point_options(CLI::App* command, Options& o, std::string& q0, const char* second, const char* second_help,
+                       std::string& second_value, double& h, bool& json, const char* json_help) {
+  add_scene(command, o, o.scene);
+  command->add_option("--q0", q0, "the point q0, comma-separated")->required()->type_name("A,B,..");
+  command->add_option(second, second_value, second_help)->required()->type_name("C,D,..");
+  command->add_option("--h", h, "the step size")->required()->type_name("H");
+  command->add_flag("--json", json, json_help);
+}
+
 void define_ld(CLI::App& app, Options& o, Command& chosen) {
   auto* ld = subcommand(app, o, "ld",
                         "Evaluate the scene's discrete Lagrangian L_d(q0, q1; h) and its derivatives D1 L_d, "
                         "D2 L_d at one point.",
                         "Example:\n  varia ld scenes/default.json --q0 1.3 --q1 1.25 --h 0.1 --json");
-  add_scene(ld, o, o.scene);
-  ld->add_option("--q0", o.ld.q0, "the first point, comma-separated")->required()->type_name("A,B,..");
-  ld->add_option("--q1", o.ld.q1, "the second point, comma-separated")->required()->type_name("C,D,..");
-  ld->add_option("--h", o.ld.h, "the step size")->required()->type_name("H");
-  ld->add_flag("--json", o.ld.json, "print {\"Ld\": x, \"D1\": [...], \"D2\": [...]}");
+  add_point_options(ld, o, o.ld.q0, "--q1", "the second point, comma-separated", o.ld.q1, o.ld.h, o.ld.json,
+                    "print {\"Ld\": x, \"D1\": [...], \"D2\": [...]}");
   ld->callback([&] { chosen = [&] { return command_ld(o.common, o.scene, o.ld); }; });
 }
 
@@ -177,11 +185,8 @@ void define_tangent(CLI::App& app, Options& o, Command& chosen) {
       "d(q1, p1)/d(q0, p0), exact (the implicit function theorem on the step's own equations), rows q1 then p1, "
       "with its symplecticity defect.",
       "Example:\n  varia tangent scenes/default.json --q0 1.3 --p0 0.2 --h 0.1 --json");
-  add_scene(tangent, o, o.scene);
-  tangent->add_option("--q0", o.tangent.q0, "the point, comma-separated")->required()->type_name("A,B,..");
-  tangent->add_option("--p0", o.tangent.p0, "the momentum, comma-separated")->required()->type_name("C,D,..");
-  tangent->add_option("--h", o.tangent.h, "the step size")->required()->type_name("H");
-  tangent->add_flag("--json", o.tangent.json, "print {\"q1\": [...], \"p1\": [...], \"jacobian\": [[...], ...]}");
+  add_point_options(tangent, o, o.tangent.q0, "--p0", "the momentum, comma-separated", o.tangent.p0, o.tangent.h,
+                    o.tangent.json, "print {\"q1\": [...], \"p1\": [...], \"jacobian\": [[...], ...]}");
   tangent->callback([&] { chosen = [&] { return command_tangent(o.common, o.scene, o.tangent); }; });
 }
 

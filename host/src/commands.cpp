@@ -3,7 +3,6 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
-#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <functional>
@@ -12,6 +11,7 @@
 #include <string_view>
 
 #include "assemble.hpp"
+#include "numbers.hpp"
 #include "output.hpp"
 #include "registry.hpp"
 #include "scene.hpp"
@@ -107,20 +107,10 @@ void print_plugins_table(const std::vector<PluginRecord>& records, const std::ve
 // ---- ld ------------------------------------------------------------------------------------------
 
 Eigen::VectorXd parse_numbers(const std::string& text, int expected, const char* flag) {
-  std::vector<double> values;
-  const char* cursor = text.c_str();
-  bool ok = !text.empty();
-  while (ok && *cursor != '\0') {
-    char* end = nullptr;
-    errno = 0;
-    values.push_back(std::strtod(cursor, &end));
-    ok = end != cursor && errno == 0 && std::isfinite(values.back()) && (*end == ',' || *end == '\0');
-    cursor = *end == ',' ? end + 1 : end;
-    if (ok && *end == ',' && *cursor == '\0') ok = false;  // a trailing comma
-  }
-  if (!ok || static_cast<int>(values.size()) != expected)
+  const std::optional<std::vector<double>> values = comma_separated_numbers(text);
+  if (!values || static_cast<int>(values->size()) != expected)
     throw InputError(fmt::format("{}: expected {} comma-separated finite numbers; found '{}'", flag, expected, text));
-  return Eigen::Map<const Eigen::VectorXd>(values.data(), expected);
+  return Eigen::Map<const Eigen::VectorXd>(values->data(), expected);
 }
 
 // A point of the manifold, checked as the scene's initial point is (scene.cpp).

@@ -19,6 +19,7 @@
 #include "errors.hpp"
 #include "interrupt.hpp"
 #include "json_reader.hpp"
+#include "numbers.hpp"
 #include "output.hpp"
 #include "plot.hpp"
 #include "progress.hpp"
@@ -42,21 +43,10 @@ constexpr double kMaxMembers = 1e7;
                                why, printable(text)));
 }
 
-std::vector<std::string> split(const std::string& text, char separator) {
-  std::vector<std::string> parts;
-  std::size_t from = 0;
-  for (std::size_t at; (at = text.find(separator, from)) != std::string::npos; from = at + 1)
-    parts.push_back(text.substr(from, at - from));
-  parts.push_back(text.substr(from));
-  return parts;
-}
-
 double finite_number(const std::string& word, const std::string& text) {
-  char* end = nullptr;
-  errno = 0;
-  const double x = std::strtod(word.c_str(), &end);
-  if (word.empty() || *end != '\0' || errno != 0 || !std::isfinite(x)) refuse_vary(text, "'" + word + "' is not a finite number");
-  return x;
+  const std::optional<double> x = host::finite_number(word);
+  if (!x) refuse_vary(text, "'" + word + "' is not a finite number");
+  return *x;
 }
 
 long count_of(const std::string& word, const std::string& text) {
@@ -74,7 +64,9 @@ VarySpec parse_vary(const std::string& text) {
   const auto parts = split(text.substr(equals + 1), ':');
   const std::string& kind = parts[0];
   if (kind == "list" && parts.size() == 2) {
-    for (const auto& word : split(parts[1], ',')) spec.values.push_back(finite_number(word, text));
+    const std::optional<std::vector<double>> values = comma_separated_numbers(parts[1]);
+    if (!values) refuse_vary(text, "'" + parts[1] + "' is not a list of comma-separated finite numbers");
+    spec.values = *values;
   } else if (kind == "linspace" && parts.size() == 4) {
     const double a = finite_number(parts[1], text), b = finite_number(parts[2], text);
     const long n = count_of(parts[3], text);

@@ -42,19 +42,25 @@ Assembly assembled(const json& document, Registry& registry, Scene& scene) {
   return assemble(scene, registry);
 }
 
+// The state of y' = field(y) at time T from `start`, by RKF7(8) at tolerances 1e-15: the Cartesian
+// references of the constrained motions below.
+template <class State, class Field>
+State integrated(State z, const Field& field, double T) {
+  namespace odeint = boost::numeric::odeint;
+  odeint::integrate_adaptive(odeint::make_controlled(1e-15, 1e-15, odeint::runge_kutta_fehlberg78<State>()), field, z,
+                             0.0, T, 1e-3);
+  return z;
+}
+
 // (x, x') at time T from (x0, v0), to about 1e-14.
 State6 reference_state(const State6& start, double T) {
-  State6 z = start;
   const auto field = [](const State6& y, State6& dy, double) {
     const double lambda = (-kGravity * y[2] + y[3] * y[3] + y[4] * y[4] + y[5] * y[5]) /
                           (y[0] * y[0] + y[1] * y[1] + y[2] * y[2]);
     for (int a = 0; a < 3; ++a) dy[a] = y[3 + a], dy[3 + a] = -lambda * y[a];
     dy[5] -= kGravity;
   };
-  namespace odeint = boost::numeric::odeint;
-  odeint::integrate_adaptive(odeint::make_controlled(1e-15, 1e-15, odeint::runge_kutta_fehlberg78<State6>()), field, z,
-                             0.0, T, 1e-3);
-  return z;
+  return integrated(start, field, T);
 }
 
 }  // namespace
@@ -134,11 +140,7 @@ State12 double_pendulum_reference(const State12& start, double m1, double m2, do
     const Eigen::Vector3d a1 = g - (lambda[0] * x1 - lambda[1] * d) / m1, a2 = g - lambda[1] * d / m2;
     for (int k = 0; k < 3; ++k) dy[k] = v1[k], dy[3 + k] = v2[k], dy[6 + k] = a1[k], dy[9 + k] = a2[k];
   };
-  State12 z = start;
-  namespace odeint = boost::numeric::odeint;
-  odeint::integrate_adaptive(odeint::make_controlled(1e-15, 1e-15, odeint::runge_kutta_fehlberg78<State12>()), field, z,
-                             0.0, T, 1e-3);
-  return z;
+  return integrated(start, field, T);
 }
 
 }  // namespace
