@@ -245,12 +245,14 @@ Eigen::MatrixXd tangent_directions(VerifiedScene& x, const Eigen::VectorXd& step
                                    1e-3 * (speed > 0.0 ? speed : 1.0));
 }
 
-// Where the map has its exact tangent map (and no constraints: the form is then restricted to the
-// constraint's tangent space, whose basis the differences take), M is the tangent map itself.
+// Where the map has its exact tangent map on a vector space (no constraints: the form is then
+// restricted to the constraint's tangent space, whose basis the differences take; not on a Lie
+// group: its images are in the natural charts, where the form is not J), M is the tangent map.
 PropertyCheck symplectic(VerifiedScene& x) {
   const Eigen::VectorXd steps = difference_steps(x);
   const Eigen::MatrixXd tangent = tangent_directions(x, steps);
-  const bool exact = !x.a.holonomic && x.a.map->tangent_map_refusal().empty();
+  const bool exact =
+      !x.a.holonomic && x.a.manifold->is_vector_space() && x.a.map->tangent_map_refusal().empty();
   const auto d = defect_values("symplectic", steps_of(x, {1, 0, -1}), kNoiseSpread * kEpsilon, [&](double h, double& noise) {
     const auto defect =
         exact ? exact_symplecticity_defect(*x.a.map, x.a.q0.data(), x.a.p0.data(), x.a.t0, h, steps,

@@ -105,6 +105,64 @@ class CommandsTest(unittest.TestCase):
         self.assertEqual(varia.verify(scene), expected)
 
 
+def rotation(axis):
+    """exp(hat(axis)), Rodrigues' formula."""
+    angle = np.linalg.norm(axis)
+    K = np.array([[0, -axis[2], axis[1]], [axis[2], 0, -axis[0]], [-axis[1], axis[0], 0]]) / angle
+    return np.eye(3) + np.sin(angle) * K + (1 - np.cos(angle)) * K @ K
+
+
+def rotation_log(R):
+    """log(R) as a vector (R near the identity)."""
+    angle = np.arccos(np.clip((np.trace(R) - 1) / 2, -1, 1))
+    W = (R - R.T) * (0.5 / np.sinc(angle / np.pi) if angle > 0 else 0.5)
+    return np.array([W[2, 1], W[0, 2], W[1, 0]])
+
+
+class TangentOnGroupTest(unittest.TestCase):
+    def test_one_step_tangent_map_on_a_product_of_groups_matches_differences(self):
+        """The two-body rigid chain (an inertia that depends on the attitudes) under Crouch-Grossman on
+        SO3 x SO3: `varia tangent` against sixth-order differences of one-step runs from
+        (R0_k exp(e x_k), p0 + e y), read in the chart at R1, log(R1_k^T R_k)."""
+        with open("scenes/multibody/rigid-body-chain-2-s1.json") as f:
+            scene = json.load(f)
+        scene["method"] = {"construction": "one-step", "one_step": {"type": "crouch-grossman", "order": 2}}
+        R0 = [rotation(np.array([0.3, -0.2, 0.1])), rotation(np.array([-0.1, 0.4, 0.2]))]
+        q0 = np.concatenate([R.reshape(-1) for R in R0])
+        p0 = np.array([0.02, -0.01, 0.03, 0.01, 0.02, -0.015])
+        h = 0.02
+        with tempfile.TemporaryDirectory() as directory:
+            path = os.path.join(directory, "chain.json")
+            with open(path, "w") as f:
+                json.dump(scene, f)
+            done = cli("tangent", path, "--q0", ",".join(repr(x) for x in q0), "--p0",
+                       ",".join(repr(x) for x in p0), "--h", repr(h), "--json")
+        self.assertEqual(done.returncode, 0, done.stderr)
+        result = json.loads(done.stdout)
+        exact, q1 = np.array(result["jacobian"]), np.array(result["q1"])
+
+        def step(x):
+            q = np.concatenate([(R0[k] @ rotation(x[3 * k:3 * k + 3]) if np.any(x[3 * k:3 * k + 3]) else R0[k])
+                                .reshape(-1) for k in range(2)])
+            scene["initial"] = {"q": list(q), "p": list(p0 + x[6:])}
+            scene["step"], scene["steps"] = h, 1
+            scene.pop("t_end", None)
+            run = varia.run(scene)
+            ends = [run.q[-1][9 * k:9 * k + 9].reshape(3, 3) for k in range(2)]
+            local = [rotation_log(q1[9 * k:9 * k + 9].reshape(3, 3).T @ ends[k]) for k in range(2)]
+            return np.concatenate(local + [run.p[-1]])
+
+        d = 1e-3
+        differences = np.zeros((12, 12))
+        for j in range(12):
+            e = np.zeros(12)
+            e[j] = d
+            differences[:, j] = (-step(-3 * e) + 9 * step(-2 * e) - 45 * step(-e) + 45 * step(e) - 9 * step(2 * e)
+                                 + step(3 * e)) / (60 * d)
+        self.assertLessEqual(np.abs(exact - differences).max(), 1e-9)
+        self.assertGreaterEqual(np.abs(exact - np.eye(12)).max(), 1e-3)
+
+
 class CostTest(unittest.TestCase):
     def test_cost_is_the_cli_cost_json(self):
         scenes = ["scenes/pendulum-galerkin-s1.json", "scenes/pendulum-galerkin-s2.json"]

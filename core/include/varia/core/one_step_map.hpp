@@ -8,6 +8,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/LU>
 #include <memory>
 #include <string>
 #include <vector>
@@ -28,14 +29,16 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
                         SolverOptions options);
   int point_size() const override { return m_; }
   int dim() const override { return n_; }
-  // Empty on a vector space with a Lagrangian that evaluates at jets.
+  // Empty where the Lagrangian evaluates at jets (on R^n and on a Lie group).
   std::string tangent_map_refusal() const override;
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
   // The step, then the method's step at first-order jets along the directions: a one-step method
   // steps jets with the exact derivatives of Psi_h (one_step.hpp), which is the implicit function
-  // theorem on its stage equations (Runge-Kutta methods commute with linearization). In passes of
-  // at most the field's jet_variables() directions.
+  // theorem on its stage equations (Runge-Kutta methods commute with linearization; a Lie group
+  // method's exponentials are differentiated as they are). In passes of at most the field's
+  // jet_variables() directions. On a Lie group the directions and images are in the natural charts
+  // at g0 and g1 (seed(), image()).
   void take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
                          const double* directions, double* images) override;
 
@@ -45,6 +48,11 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
   const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
 
  private:
+  void prepare_group_tangent();
+  void seed(const double* dx);
+  void image(double* out) const;
+
+  Manifold& manifold_;
   LagrangianEvaluator lagrangian_;
   std::unique_ptr<EulerLagrangeField> field_;
   OneStepMethod& method_;
@@ -56,7 +64,13 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
   SolverStatistics statistics_;
   Eigen::VectorXd y0_, y1_;
   std::vector<Jet2> jets0_, jets1_;  // the tangent map's state at jets
-  Eigen::VectorXd deviation_w_;      // a direction's w part
+  Eigen::VectorXd column_;           // a direction's derivative of the state (m + n)
+  // On a Lie group (prepare_group_tangent): D(g0), C1^T, L's Hessians and L_xixi's LU at the ends.
+  std::vector<Jet2> point_jets_, generator_jets_;
+  Eigen::MatrixXd generators_, chart_inverse_, hessian0_, hessian1_;
+  Eigen::VectorXd gradient_, local_value_;
+  std::vector<double> local_hessian_;
+  Eigen::PartialPivLU<Eigen::MatrixXd> inertia_lu_;
   SolverStatistics tangent_stages_;  // the jet steps' stage solves (not the run's)
 };
 
