@@ -160,6 +160,49 @@ void LieGroupVelocityVerlet::take_step(const double* q0, const double* p0, doubl
   has_last_ = true;
 }
 
+void LieGroupVelocityVerlet::linearize_torque(const Eigen::Matrix3d& R, TorqueLinearization& at) {
+  double q[9];
+  const double omega[3] = {0.0, 0.0, 0.0};
+  to_row_major(R, q);
+  at.R = R;
+  lagrangian_.hessian(q, omega, gradient_.data(), at.hessian.data());
+  at.gradient = from_row_major(gradient_.data());
+}
+
+Eigen::Vector3d LieGroupVelocityVerlet::torque_derivative(const TorqueLinearization& at, const Eigen::Vector3d& delta) {
+  const Eigen::Matrix3d dR = at.R * hat(delta);
+  Eigen::Matrix<double, 9, 1> dq, dG;  // row-major, as q
+  to_row_major(dR, dq.data());
+  dG.noalias() = at.hessian.topLeftCorner<9, 9>() * dq;
+  return Eigen::Vector3d(so3::trivialize(dR, at.gradient) + so3::trivialize(at.R, from_row_major(dG.data())));
+}
+
+void LieGroupVelocityVerlet::take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1,
+                                               double* p1, int count, const double* directions, double* images) {
+  take_step(q0, p0, t0, h, q1, p1);
+  TorqueLinearization start, end;
+  linearize_torque(from_row_major(q0), start);
+  linearize_torque(from_row_major(q1), end);
+  const Eigen::Vector3d Pi0(p0[0], p0[1], p0[2]);
+  const Eigen::Vector3d half_kick = Pi0 + 0.5 * h * so3::trivialize(start.R, start.gradient);
+  const Eigen::Matrix3d F = start.R.transpose() * end.R;
+  Eigen::Matrix3d K;
+  for (int a = 0; a < 3; ++a) {
+    const Eigen::Matrix3d X = F * hat(Eigen::Vector3d(Eigen::Vector3d::Unit(a))) * Jd_;
+    K.col(a) = vee(Eigen::Matrix3d(X - X.transpose()));
+  }
+  const Eigen::PartialPivLU<Eigen::Matrix3d> lu(K);
+  const Eigen::Vector3d kicked = F.transpose() * half_kick;
+  for (int j = 0; j < count; ++j) {
+    const Eigen::Map<const Eigen::Vector3d> delta0(directions + 6 * j), dPi0(directions + 6 * j + 3);
+    Eigen::Map<Eigen::Vector3d> delta1(images + 6 * j), dPi1(images + 6 * j + 3);
+    const Eigen::Vector3d dM0 = torque_derivative(start, delta0);
+    const Eigen::Vector3d phi = lu.solve(Eigen::Vector3d(h * dPi0 + 0.5 * h * h * dM0));
+    delta1 = F.transpose() * delta0 + phi;
+    dPi1 = -phi.cross(kicked) + F.transpose() * (dPi0 + 0.5 * h * dM0) + 0.5 * h * torque_derivative(end, delta1);
+  }
+}
+
 // L_d = (1/h) tr((I - F) J_d) + h/2 (L(R0, 0) + L(R1, 0)), and with R0 -> R0 exp(eps eta),
 // R1 -> R1 exp(eps eta) (left-trivialized derivatives):
 //   D1 L_d = (1/h) vee(J_d F^T - F J_d) + h/2 M0,   D2 L_d = (1/h) vee(J_d F - F^T J_d) + h/2 M1.

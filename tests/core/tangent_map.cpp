@@ -15,6 +15,7 @@
 #include "core/so3_reference.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/galerkin_chart.hpp"
+#include "varia/core/lie_verlet.hpp"
 #include "varia/core/one_step_map.hpp"
 #include "varia/core/shooting.hpp"
 #include "varia/core/verification.hpp"
@@ -81,6 +82,16 @@ TangentCase tangent_and_differences_on(Manifold& manifold, DiscreteHamiltonianMa
                                 (60 * d);
   }
   return result;
+}
+
+// On a Lie group: the tangent map agrees with the differences in the charts, and the step moves.
+void check_tangent_on(Manifold& manifold, DiscreteHamiltonianMap& map, const Eigen::VectorXd& q0,
+                      const Eigen::VectorXd& p0) {
+  const TangentCase m = tangent_and_differences_on(manifold, map, q0, p0, 0.05);
+  const double difference = (m.exact - m.differences).cwiseAbs().maxCoeff();
+  MESSAGE("largest difference " << difference);
+  CHECK(difference <= 1e-10);
+  CHECK((m.exact - Eigen::MatrixXd::Identity(m.exact.rows(), m.exact.cols())).cwiseAbs().maxCoeff() >= 1e-3);
 }
 
 // The tangent map agrees with the differences (their error: O(d^6) and eps / d) and its
@@ -201,11 +212,21 @@ TEST_CASE("the one-step construction's tangent map on a Lie group: the heavy top
   for (OneStepMethod* method : {static_cast<OneStepMethod*>(&midpoint), crouch.get()}) {
     OneStepHamiltonianMap map(group, top, *method, {});
     REQUIRE(map.tangent_map_refusal().empty());
-    const TangentCase m = tangent_and_differences_on(group, map, R0, p0, 0.05);
-    const double difference = (m.exact - m.differences).cwiseAbs().maxCoeff();
-    MESSAGE("largest difference " << difference);
-    CHECK(difference <= 1e-10);
-    CHECK((m.exact - Eigen::MatrixXd::Identity(6, 6)).cwiseAbs().maxCoeff() >= 1e-3);  // it moves
+    check_tangent_on(group, map, R0, p0);
+  }
+}
+
+TEST_CASE("the lie-verlet construction's tangent map (the LGVI, both solvers): the heavy top on SO(3) in the natural "
+          "charts at R0 and R1") {
+  Rotations group;
+  Top top(Eigen::Vector3d(1.0, 1.5, 0.8), 1.0, Eigen::Vector3d(0.1, 0.2, 0.5));
+  Eigen::VectorXd R0(9), p0(3);
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8);
+  REQUIRE(group.retract(vector_of({1, 0, 0, 0, 1, 0, 0, 0, 1}).data(), axis.data(), R0.data()) == nullptr);
+  p0 << 0.5, -0.45, 1.6;
+  for (LieVerletSolver solver : {LieVerletSolver::cayley, LieVerletSolver::exp}) {
+    LieGroupVelocityVerlet map(group, top, solver, {});
+    check_tangent_on(group, map, R0, p0);
   }
 }
 

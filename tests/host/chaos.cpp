@@ -44,10 +44,10 @@ TEST_CASE("tangent --json prints q1, p1 and the step's Jacobian, symplectic for 
 }
 
 TEST_CASE("tangent refuses what has no tangent map and bad flags, exit 2 with one line") {
-  const auto lgvi =
-      run_varia("tangent scenes/paper/rigid-body-lgvi.json --q0 1,0,0,0,1,0,0,0,1 --p0 0.1,0.2,0.3 --h 0.1");
-  CHECK(lgvi.code == 2);
-  check_one_error_line(lgvi, "/method/construction: expected a construction with a tangent map");
+  const auto on_group = run_varia(
+      "tangent scenes/paper/rigid-body-galerkin-s2.json --q0 1,0,0,0,1,0,0,0,1 --p0 0.1,0.2,0.3 --h 0.1");
+  CHECK(on_group.code == 2);
+  check_one_error_line(on_group, "/method/construction: expected a construction with a tangent map");
   const auto p0 = run_varia("tangent scenes/kepler-galerkin.json --q0 0.5,0 --p0 1 --h 0.05");
   CHECK(p0.code == 2);
   check_one_error_line(p0, "--p0: expected 2 comma-separated finite numbers");
@@ -77,7 +77,7 @@ TEST_CASE("megno and lyapunov: the chaotic double pendulum (MEGNO > 8, lambda > 
 }
 
 TEST_CASE("megno on a construction without a tangent map is refused at /observe, exit 2") {
-  const auto outcome = run_varia("validate scenes/paper/rigid-body-lgvi.json --set '/observe=[\"megno\"]'");
+  const auto outcome = run_varia("validate scenes/paper/rigid-body-galerkin-s2.json --set '/observe=[\"megno\"]'");
   CHECK(outcome.code == 2);
   check_one_error_line(outcome, "/observe: expected no \"megno\"");
 }

@@ -17,6 +17,7 @@
 
 #include <Eigen/Core>
 #include <array>
+#include <string>
 #include <vector>
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
@@ -40,8 +41,18 @@ class LieGroupVelocityVerlet : public DiscreteLagrangian, public DiscreteHamilto
   int dim() const override { return 3; }
   // Throws NumericalFailure when F J_d - J_d F^T = hat(g) has no solution on the branch through
   // F = I: the step turns the body too far (about h |Omega| > 1 for a spin about a principal axis).
+  std::string tangent_map_refusal() const override { return {}; }
+
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
+  // The implicit function theorem on the step's equation, in the natural charts at R0 and R1
+  // (R0 exp(e hat(delta0)), Pi0 + e dPi0): with F perturbed as F exp(e hat(phi)),
+  //   K phi = h dPi0 + h^2/2 dM0,   K e_a = vee(X_a - X_a^T), X_a = F hat(e_a) J_d
+  // (hat(g) = F J_d - J_d F^T differentiated), then R1 = R0 F moves by delta1 = F^T delta0 + phi and
+  //   dPi1 = -phi x F^T (Pi0 + h/2 M0) + F^T (dPi0 + h/2 dM0) + h/2 dM1,
+  // dM the torque's derivative along the chart (torque_derivative).
+  void take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
+                         const double* directions, double* images) override;
 
  public:
   const SolverStatistics& solver_statistics() const override { return statistics_; }
@@ -58,6 +69,15 @@ class LieGroupVelocityVerlet : public DiscreteLagrangian, public DiscreteHamilto
   Eigen::Matrix3d solve(const Eigen::Vector3d& g);
   // M = the left-trivialized dL/dR at (R, Omega = 0): the potential's torque on the body.
   Eigen::Vector3d torque(const Eigen::Matrix3d& R);
+  // The torque at R exp(e hat(delta)) differentiated in e: M = trivialize(R, dL/dR) is bilinear, so
+  // dM = trivialize(R hat(delta), dL/dR) + trivialize(R, L_RR R hat(delta)), L's Hessian at (R, 0)
+  // taken once per point (linearize_torque).
+  struct TorqueLinearization {
+    Eigen::Matrix3d R, gradient;
+    Eigen::Matrix<double, 12, 12> hessian;
+  };
+  void linearize_torque(const Eigen::Matrix3d& R, TorqueLinearization& at);
+  static Eigen::Vector3d torque_derivative(const TorqueLinearization& at, const Eigen::Vector3d& delta);
   // tr(J_d (F - I)) and vee(X - X^T) for X = (F - I) J_d, free of the cancellations of F J_d.
   double trace_product(const Eigen::Matrix3d& F_minus_I) const;
   Eigen::Vector3d skew_part(const Eigen::Matrix3d& F_minus_I) const;
