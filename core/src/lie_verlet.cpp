@@ -180,9 +180,11 @@ Eigen::Vector3d LieGroupVelocityVerlet::torque_derivative(const TorqueLinearizat
 void LieGroupVelocityVerlet::take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1,
                                                double* p1, int count, const double* directions, double* images) {
   take_step(q0, p0, t0, h, q1, p1);
-  TorqueLinearization start, end;
-  linearize_torque(from_row_major(q0), start);
+  TorqueLinearization start = tangent_end_;  // the last tangent step's end, where this one continues it
+  if (!(has_tangent_end_ && start.R == from_row_major(q0))) linearize_torque(from_row_major(q0), start);
+  TorqueLinearization& end = tangent_end_;
   linearize_torque(from_row_major(q1), end);
+  has_tangent_end_ = true;
   const Eigen::Vector3d Pi0(p0[0], p0[1], p0[2]);
   const Eigen::Vector3d half_kick = Pi0 + 0.5 * h * so3::trivialize(start.R, start.gradient);
   const Eigen::Matrix3d F = start.R.transpose() * end.R;

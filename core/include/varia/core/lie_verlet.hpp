@@ -78,6 +78,8 @@ class LieGroupVelocityVerlet : public DiscreteLagrangian, public DiscreteHamilto
   };
   void linearize_torque(const Eigen::Matrix3d& R, TorqueLinearization& at);
   static Eigen::Vector3d torque_derivative(const TorqueLinearization& at, const Eigen::Vector3d& delta);
+  TorqueLinearization tangent_end_;  // at the last tangent step's R1
+  bool has_tangent_end_ = false;
   // tr(J_d (F - I)) and vee(X - X^T) for X = (F - I) J_d, free of the cancellations of F J_d.
   double trace_product(const Eigen::Matrix3d& F_minus_I) const;
   Eigen::Vector3d skew_part(const Eigen::Matrix3d& F_minus_I) const;
