@@ -83,7 +83,7 @@ double GalerkinDiscreteLagrangian::action_for(double h, Order order, bool forced
     S += h * b * L;
     if (order == Order::value) continue;
     for (int c = 0; c < n; ++c) impulse_[c] += (h * b) * grad_[c];
-    if (node_iteration_) inverse_mass_times(grad_.data(), node_accelerations_.data() + j * n);
+    if (node_iteration_) inverse_mass_times<Eigen::Dynamic>(grad_.data(), node_accelerations_.data() + j * n);
     ++j;
     if (forced) add_forces(i, h, order);
     if (order == Order::hessian && sparse)

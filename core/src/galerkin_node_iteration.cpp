@@ -65,6 +65,37 @@ template <int N, int Rows, int C>
     }
 }
 
+// a = M^{-1} g (n numbers each, apart): by M^{-1} in a loop of fixed length where n is small, or by
+// the sparse Cholesky factor of M in place (natural order: no permutation, no temporary; a
+// diagonal M divides). A sparse M is factorized at the first step (solve_at_nodes); before it, the
+// action's accelerations (used by steps only) are not formed.
+void GalerkinDiscreteLagrangian::sparse_inverse_mass_times(const double* g, double* a) {
+  if (sparse_mass_.rows() == 0) return;
+  Eigen::Map<Eigen::VectorXd> x(a, n_);
+  const Eigen::Map<const Eigen::VectorXd> b(g, n_);
+  if (diagonal_mass_) {  // particles: one rounding, g / m
+    x.array() = b.array() / sparse_mass_.coeffs().array();
+    return;
+  }
+  x = b;
+  sparse_mass_solver_.matrixL().solveInPlace(x);
+  sparse_mass_solver_.matrixU().solveInPlace(x);
+}
+
+template <int N>
+[[gnu::always_inline]] inline void GalerkinDiscreteLagrangian::inverse_mass_times(const double* __restrict g,
+                                                                                  double* __restrict a) {
+  if (lagrangian_.sparse()) return sparse_inverse_mass_times(g, a);  // out of line: the dense loop stays small
+  const int n = fixed_or<N>(n_);
+  const double* __restrict M_inverse = inverse_mass_.data();
+  for (int c = 0; c < n; ++c) {
+    double sum = 0.0;
+    for (int d = 0; d < n; ++d) sum += M_inverse[c + d * n] * g[d];
+    a[c] = sum;
+  }
+}
+template void GalerkinDiscreteLagrangian::inverse_mass_times<Eigen::Dynamic>(const double*, double*);
+
 // The fixed point's residual at the nodes' offsets D (node_offsets_): the forces g_j = dL/dq at
 // q0 + D_j in one plugin call (Lagrangian::gradients; v = 0: for this Lagrangian L_q does not
 // depend on v), kept with M^{-1} g_j, the offsets D' that the step's equations give for those
@@ -84,7 +115,6 @@ template <int N, int R>
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
   const double* __restrict q0 = origin_.data();
   const double* __restrict D = node_offsets_.data();
-  const double* __restrict M_inverse = inverse_mass_.data();
   double* __restrict z = node_points_.data();
   double* __restrict gradients = node_gradients_.data();
   double* __restrict accelerations = node_accelerations_.data();
@@ -92,18 +122,7 @@ template <int N, int R>
   for (int j = 0; j < nodes; ++j)
     for (int c = 0; c < n; ++c) z[2 * n * j + c] = q0[c] + D[j * n + c];
   lagrangian_.gradients(nodes, z, gradients);
-  for (int j = 0; j < nodes; ++j) {
-    const double* g = gradients + 2 * n * j;
-    if (sparse_mass_.rows() > 0) {
-      inverse_mass_times(g, accelerations + j * n);
-      continue;
-    }
-    for (int c = 0; c < n; ++c) {
-      double a = 0.0;
-      for (int d = 0; d < n; ++d) a += M_inverse[c + d * n] * g[d];
-      accelerations[j * n + c] = a;
-    }
-  }
+  for (int j = 0; j < nodes; ++j) inverse_mass_times<N>(gradients + 2 * n * j, accelerations + j * n);
   offsets_from_forces<N, R, R>(node_map_, h, accelerations, next);
   if (scale == 0.0) {
     double largest = 0.0;
@@ -113,26 +132,6 @@ template <int N, int R>
   }
   for (int k = 0; k < nodes * n; ++k) F[k] = (D[k] - next[k]) * scale;
   return 0.0;
-}
-
-// a = M^{-1} g (n numbers each, apart): by M^{-1}, or by the sparse Cholesky factor of M, in
-// place (natural order: no permutation, no temporary). A sparse M is factorized at the first step
-// (solve_at_nodes); before it, the action's accelerations (used by steps only) are not formed.
-void GalerkinDiscreteLagrangian::inverse_mass_times(const double* g, double* a) {
-  Eigen::Map<Eigen::VectorXd> x(a, n_);
-  const Eigen::Map<const Eigen::VectorXd> b(g, n_);
-  if (!lagrangian_.sparse()) {
-    x.noalias() = inverse_mass_ * b;
-    return;
-  }
-  if (sparse_mass_.rows() == 0) return;
-  if (diagonal_mass_) {  // particles: one rounding, g / m
-    x.array() = b.array() / sparse_mass_.coeffs().array();
-    return;
-  }
-  x = b;
-  sparse_mass_solver_.matrixL().solveInPlace(x);
-  sparse_mass_solver_.matrixU().solveInPlace(x);
 }
 
 // The fixed point D = D'(g(q0 + D)) as a NewtonSolver system with the Jacobian M / h at every node
@@ -174,16 +173,8 @@ struct GalerkinDiscreteLagrangian::NodeIteration {
 template <int N, int R>
 bool GalerkinDiscreteLagrangian::solve_at_nodes(const double* p0, double h, bool continues) {
   const int n = fixed_or<N>(n_), nodes = fixed_or<R>(static_cast<int>(iteration_nodes_.size()));
-  if (lagrangian_.sparse()) {
-    if (sparse_mass_.rows() == 0) factorize_sparse_mass(origin_.data());
-    inverse_mass_times(p0, velocity0_.data());
-  } else {
-    for (int c = 0; c < n; ++c) {
-      double u = 0.0;
-      for (int d = 0; d < n; ++d) u += inverse_mass_.data()[c + d * n] * p0[d];
-      velocity0_[c] = u;
-    }
-  }
+  if (lagrangian_.sparse() && sparse_mass_.rows() == 0) factorize_sparse_mass(origin_.data());
+  inverse_mass_times<N>(p0, velocity0_.data());
   double speed = 0.0, origin = 0.0;
   for (int c = 0; c < n; ++c) {
     speed = std::max(speed, std::abs(velocity0_[c]));

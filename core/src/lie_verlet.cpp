@@ -71,13 +71,18 @@ void LieGroupVelocityVerlet::residual(const Eigen::Vector3d& f, const Eigen::Vec
   }
   D = so3::expm1(f);
   r = skew_part(D) - g;
-  const Eigen::Matrix3d F = Eigen::Matrix3d::Identity() + D;
+  jacobian = skew_part_derivative(Eigen::Matrix3d(Eigen::Matrix3d::Identity() + D)) * so3::dexp(Eigen::Vector3d(-f));
+}
+
+// K with K e_a = vee(X_a - X_a^T), X_a = F hat(e_a) J_d: vee(F J_d - J_d F^T) differentiated along
+// F exp(e hat(e_a)).
+Eigen::Matrix3d LieGroupVelocityVerlet::skew_part_derivative(const Eigen::Matrix3d& F) const {
   Eigen::Matrix3d K;
   for (int a = 0; a < 3; ++a) {
     const Eigen::Matrix3d X = F * hat(Eigen::Vector3d(Eigen::Vector3d::Unit(a))) * Jd_;
     K.col(a) = vee(Eigen::Matrix3d(X - X.transpose()));
   }
-  jacobian = K * so3::dexp(Eigen::Vector3d(-f));
+  return K;
 }
 
 // The equation for f as a system for NewtonSolver (solve/newton.hpp), with the exact Jacobian.
@@ -188,12 +193,7 @@ void LieGroupVelocityVerlet::take_tangent_step(const double* q0, const double* p
   const Eigen::Vector3d Pi0(p0[0], p0[1], p0[2]);
   const Eigen::Vector3d half_kick = Pi0 + 0.5 * h * so3::trivialize(start.R, start.gradient);
   const Eigen::Matrix3d F = start.R.transpose() * end.R;
-  Eigen::Matrix3d K;
-  for (int a = 0; a < 3; ++a) {
-    const Eigen::Matrix3d X = F * hat(Eigen::Vector3d(Eigen::Vector3d::Unit(a))) * Jd_;
-    K.col(a) = vee(Eigen::Matrix3d(X - X.transpose()));
-  }
-  const Eigen::PartialPivLU<Eigen::Matrix3d> lu(K);
+  const Eigen::PartialPivLU<Eigen::Matrix3d> lu(skew_part_derivative(F));
   const Eigen::Vector3d kicked = F.transpose() * half_kick;
   for (int j = 0; j < count; ++j) {
     const Eigen::Map<const Eigen::Vector3d> delta0(directions + 6 * j), dPi0(directions + 6 * j + 3);

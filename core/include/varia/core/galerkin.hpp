@@ -170,7 +170,9 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   struct NodeIteration;
   template <int N, int R>
   double node_residual(double h, double inverse_h, double speed, double& scale, double* F);
+  template <int N>
   void inverse_mass_times(const double* g, double* a);
+  void sparse_inverse_mass_times(const double* g, double* a);
   template <int N, int R>
   bool solve_at_nodes(const double* p0, double h, bool continues);
   void predict_accelerations();

@@ -83,6 +83,7 @@ class LieGroupVelocityVerlet : public DiscreteLagrangian, public DiscreteHamilto
   // tr(J_d (F - I)) and vee(X - X^T) for X = (F - I) J_d, free of the cancellations of F J_d.
   double trace_product(const Eigen::Matrix3d& F_minus_I) const;
   Eigen::Vector3d skew_part(const Eigen::Matrix3d& F_minus_I) const;
+  Eigen::Matrix3d skew_part_derivative(const Eigen::Matrix3d& F) const;
 
   LagrangianEvaluator lagrangian_;
   LieVerletSolver solver_;
