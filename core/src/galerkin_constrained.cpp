@@ -132,32 +132,11 @@ void GalerkinDiscreteLagrangian::constrained_newton(double h, int first_unknown,
   require_converged(solver_.solve(equations, statistics_), "the constrained Galerkin equations");
 }
 
-// The stored entries of the constant mass matrix: a dense Lagrangian's constant_mass_matrix, a
-// sparse one's Hessian's velocity block at q (constant, so any point gives it). The projection's M
-// here, and the sparse explicit form's (galerkin_explicit.cpp, factorize_sparse_mass).
-std::vector<Eigen::Triplet<double>> GalerkinDiscreteLagrangian::mass_entries(const double* q) {
-  std::vector<Eigen::Triplet<double>> mass;
-  if (lagrangian_.sparse()) {
-    velocity_.setZero();
-    lagrangian_.sparse_hessian(q, velocity_.data(), grad_.data(), sparse_values_.data());
-    for (int e = 0; e < lagrangian_.pattern_size(); ++e)
-      if (entries_[e].row_v && entries_[e].col_v) mass.emplace_back(entries_[e].row, entries_[e].col, sparse_values_[e]);
-    return mass;
-  }
-  Eigen::MatrixXd M(n_, n_);
-  if (!lagrangian_.plugin().constant_mass_matrix(M.data()))
-    throw std::invalid_argument("constraints need a Lagrangian with a constant mass matrix");
-  for (int c = 0; c < n_; ++c)
-    for (int r = 0; r < n_; ++r)
-      if (M(r, c) != 0.0) mass.emplace_back(r, c, M(r, c));
-  return mass;
-}
-
 // p1 = p0 + impulse_ onto the constraint's cotangent space at q1 = q0 + (q^s - q^0): impulse_ gains
 // -G(q1)^T mu (CotangentProjection).
 void GalerkinDiscreteLagrangian::project_momentum(const double* p0) {
   q_ = origin_ + points_.col(s_);
-  if (projection_ == nullptr) projection_ = std::make_unique<CotangentProjection>(*constraints_, mass_entries(q_.data()));
+  if (projection_ == nullptr) projection_ = std::make_unique<CotangentProjection>(*constraints_, constant_mass_entries(lagrangian_, q_.data()));
   v_ = Eigen::Map<const Eigen::VectorXd>(p0, n_) + impulse_;  // (workspace: the momentum to project)
   projection_->correction(q_.data(), v_.data(), momentum_.data());
   impulse_ += momentum_;

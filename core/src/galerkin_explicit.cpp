@@ -178,7 +178,7 @@ void GalerkinDiscreteLagrangian::keep_explicit_state(const double* q, const doub
 }
 
 void GalerkinDiscreteLagrangian::factorize_sparse_mass(const double* q) {
-  const std::vector<Eigen::Triplet<double>> triplets = mass_entries(q);
+  const std::vector<Eigen::Triplet<double>> triplets = constant_mass_entries(lagrangian_, q);
   sparse_mass_.resize(n_, n_);
   sparse_mass_.setFromTriplets(triplets.begin(), triplets.end());
   diagonal_mass_ = sparse_mass_.nonZeros() == n_;

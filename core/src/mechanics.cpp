@@ -190,4 +190,25 @@ double LagrangianEvaluator::energy(const double* q, const double* v) {
   return gradient_.tail(n_).dot(Eigen::Map<const Eigen::VectorXd>(v, n_)) - L;
 }
 
+std::vector<Eigen::Triplet<double>> constant_mass_entries(LagrangianEvaluator& evaluator, const double* q) {
+  const int m = evaluator.position_size(), n = evaluator.velocity_size();
+  std::vector<Eigen::Triplet<double>> mass;
+  if (evaluator.sparse()) {
+    const Eigen::VectorXd v = Eigen::VectorXd::Zero(n);
+    Eigen::VectorXd gradient(m + n), values(evaluator.pattern_size());
+    evaluator.sparse_hessian(q, v.data(), gradient.data(), values.data());
+    for (int e = 0; e < evaluator.pattern_size(); ++e)
+      if (evaluator.pattern_rows()[e] >= m && evaluator.pattern_cols()[e] >= m)
+        mass.emplace_back(evaluator.pattern_rows()[e] - m, evaluator.pattern_cols()[e] - m, values[e]);
+    return mass;
+  }
+  Eigen::MatrixXd M(n, n);
+  if (!evaluator.plugin().constant_mass_matrix(M.data()))
+    throw std::invalid_argument("constraints need a Lagrangian with a constant mass matrix");
+  for (int c = 0; c < n; ++c)
+    for (int r = 0; r < n; ++r)
+      if (M(r, c) != 0.0) mass.emplace_back(r, c, M(r, c));
+  return mass;
+}
+
 }  // namespace varia

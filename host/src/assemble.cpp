@@ -35,21 +35,34 @@ bool has_constant_mass_matrix(Lagrangian& lagrangian) {
 }
 
 // Spec "Constrained systems": the constraints, bound to the system (its coordinates, and its particles'
-// space where the Lagrangian is a particle system), as one g. A construction that does not take them
-// on this manifold, or a Lagrangian without a constant mass matrix (the hidden constraint's
-// projection, docs/constraints.md), is refused at /system/constraints.
+// space where the Lagrangian is a particle system), as one g, after an embedded manifold's own
+// equations. A construction that does not take them on this manifold, or a Lagrangian without a
+// constant mass matrix (the hidden constraint's projection, docs/constraints.md), is refused at
+// /system/constraints (at /system/manifold for the manifold's equations).
 void create_constraints(const Scene& scene, Registry& registry, Assembly& a) {
-  if (scene.constraints.empty()) return;
+  if (scene.constraints.empty() && !a.embedded) return;
+  const std::string pointer = scene.constraints.empty() ? "/system/manifold" : "/system/constraints";
+  const std::string what = scene.constraints.empty()
+                               ? fmt::format("the {} manifold is served in its embedding, with its equations' "
+                                             "multipliers, as constraints are",
+                                             scene.manifold.type)
+                               : "constraints are";
   if (!scene.construction->takes_constraints(a.manifold->structure()))
-    throw InputError(fmt::format("/system/constraints: constraints are taken by the galerkin construction on vector "
-                                 "spaces (docs/constraints.md), not by '{}' on the {} manifold",
-                                 scene.construction->name(), scene.manifold.type));
+    throw InputError(fmt::format("{}: {} taken by the galerkin construction on vector spaces (docs/constraints.md), "
+                                 "not by '{}' on the {} manifold",
+                                 pointer, what, scene.construction->name(), scene.manifold.type));
   if (!has_constant_mass_matrix(*a.lagrangian))
-    throw InputError(fmt::format("/system/constraints: constraints need a Lagrangian with a constant mass matrix (the "
-                                 "momenta's projection onto the constraint), and the {} Lagrangian declares none",
-                                 scene.lagrangian.type));
+    throw InputError(fmt::format("{}: constraints need a Lagrangian with a constant mass matrix (the momenta's "
+                                 "projection onto the constraint), and the {} Lagrangian declares none",
+                                 pointer, scene.lagrangian.type));
   std::vector<Constraint*> bound;
   const int n = a.manifold->dim();
+  if (a.embedded) {
+    Constraint* equations = a.embedded->defining_constraint();
+    equations->set_origin(a.embedded->origin());
+    check(*equations, equations->bind(n, 0), "the manifold's equations");
+    bound.push_back(equations);
+  }
   for (const auto& spec : scene.constraints) {
     auto constraint = make_part<Constraint>(registry, spec, scene, *a.manifold);
     if (const Status refused = constraint->bind(n, a.lagrangian->space_dim()); refused != nullptr)
@@ -58,6 +71,19 @@ void create_constraints(const Scene& scene, Registry& registry, Assembly& a) {
     a.constraints.push_back(std::move(constraint));
   }
   a.holonomic = std::make_unique<HolonomicConstraints>(bound, n);
+  if (!a.embedded) return;
+  std::vector<Eigen::Triplet<double>> identity;
+  for (int i = 0; i < n; ++i) identity.emplace_back(i, i, 1.0);
+  a.orthogonal_momentum = std::make_unique<CotangentProjection>(*a.holonomic, identity);
+}
+
+// A manifold served in its embedding (Manifold::defining_constraint): the constructions take it
+// as R^point_size, through the bundled Rn, and its equations as constraints (create_constraints).
+void serve_in_embedding(Registry& registry, Assembly& a) {
+  if (a.manifold->defining_constraint() == nullptr) return;
+  a.embedded = a.manifold;
+  a.manifold = registry.create_as<Manifold>("manifold", "Rn", nlohmann::json{{"dim", a.embedded->point_size()}},
+                                            sdk::Context{"Rn", 0, 0});
 }
 
 // Spec: initial.q satisfies every constraint within kInitialConstraintTolerance (the rod's g is
@@ -82,13 +108,17 @@ void check_initial_constraints(const Scene& scene, Assembly& a) {
                                  scene.v ? "v" : "p", tolerance, Gv));
 }
 
-// The constructions serve vector spaces and Lie groups (a product of Lie groups is one); a
-// manifold of another structure is refused here, once, for every construction.
-void check_structure_served(const Scene& scene, const Manifold& manifold) {
+// The constructions serve vector spaces and Lie groups (a product of Lie groups is one), and a
+// manifold that gives its equations in its embedding (S2); a manifold of another structure is
+// refused here, once, for every construction.
+void check_structure_served(const Scene& scene, Manifold& manifold) {
   const ManifoldStructure structure = manifold.structure();
-  if (structure == ManifoldStructure::vector_space || structure == ManifoldStructure::lie_group) return;
+  if (structure == ManifoldStructure::vector_space || structure == ManifoldStructure::lie_group ||
+      manifold.defining_constraint() != nullptr)
+    return;
   throw InputError(fmt::format(
-      "/system/manifold: the {} manifold is a {}, and the constructions serve vector spaces and Lie groups",
+      "/system/manifold: the {} manifold is a {}, and the constructions serve vector spaces, Lie groups and "
+      "manifolds given by their equations in R^n (S2, and products of those with vector spaces)",
       scene.manifold.type, structure_name(structure)));
 }
 
@@ -121,11 +151,12 @@ void check_dense_size(const Scene& scene, const Lagrangian& lagrangian) {
 
 // Spec "observe": momentum needs a declared symmetry; orthogonality a manifold embedded with a
 // constraint (the rotation matrix of SO3 and SE3: Manifold::has_constraint).
-void check_observables(const Scene& scene, Lagrangian& lagrangian, const Manifold& manifold) {
+void check_observables(const Scene& scene, Lagrangian& lagrangian, Manifold& manifold) {
   if (scene.observe.momentum && lagrangian.momentum_size() <= 0)
     throw InputError(fmt::format("/observe: expected no \"momentum\": the {} Lagrangian declares no symmetry",
                                  scene.lagrangian.type));
-  if ((scene.observe.constraint || scene.observe.constraint_velocity) && scene.constraints.empty())
+  if ((scene.observe.constraint || scene.observe.constraint_velocity) && scene.constraints.empty() &&
+      manifold.defining_constraint() == nullptr)
     throw InputError(fmt::format("/observe: expected no \"{}\": the system has no constraints",
                                  scene.observe.constraint ? "constraint" : "constraint_velocity"));
   if (scene.observe.orthogonality && !manifold.has_constraint())
@@ -143,11 +174,30 @@ void check_tangent_map(const Scene& scene, const DiscreteHamiltonianMap& map) {
                                  scene.observe.megno ? "megno" : "lyapunov", refusal));
 }
 
+// initial.p on an embedded manifold: orthogonal to the normals, else exit 2 at /initial/p; then
+// held as M v with G v = 0 (CotangentProjection with the mass matrix).
+void held_momentum(Assembly& a, LagrangianEvaluator& evaluator) {
+  a.holonomic->evaluate_jacobian(a.q0.data());
+  const Eigen::VectorXd normal = a.holonomic->jacobian() * a.p0;
+  const double tolerance = kInitialConstraintTolerance * std::max(1.0, a.p0.lpNorm<Eigen::Infinity>());
+  if (const double Gp = normal.lpNorm<Eigen::Infinity>(); !(Gp <= tolerance))
+    throw InputError(fmt::format("/initial/p: expected a momentum orthogonal to the manifold's normals (max |(G(q) "
+                                 "p)_i| <= {:.3g}, q . p = 0 on S2); found {:.3g}",
+                                 tolerance, Gp));
+  CotangentProjection held(*a.holonomic, constant_mass_entries(evaluator, a.q0.data()));
+  Eigen::VectorXd correction(a.p0.size());
+  held.correction(a.q0.data(), a.p0.data(), correction.data());
+  a.p0 += correction;
+}
+
 Eigen::VectorXd to_vector(const std::vector<double>& values) {
   return Eigen::Map<const Eigen::VectorXd>(values.data(), static_cast<Eigen::Index>(values.size()));
 }
 
-// Spec "initial": p, or v converted by the Legendre transform p = dL/dv.
+// Spec "initial": p, or v converted by the Legendre transform p = dL/dv. On an embedded manifold
+// p is given orthogonal to the normals (S2: q . p = 0, within the constraints' tolerance relative
+// to |p|) and held as the constructions hold it, p - G^T mu with G M^-1 p = 0 (Assembly::
+// orthogonal_momentum).
 void initial_state(const Scene& scene, Assembly& a) {
   LagrangianEvaluator evaluator(*a.lagrangian);
   a.q0 = to_vector(scene.q);
@@ -159,6 +209,7 @@ void initial_state(const Scene& scene, Assembly& a) {
     return;
   }
   a.p0 = to_vector(*scene.p);
+  if (a.orthogonal_momentum) held_momentum(a, evaluator);
   if (!scene.observe.energy && !scene.observe.momentum) return;
   a.v0 = Eigen::VectorXd::Zero(a.p0.size());
   evaluator.inverse_legendre(a.q0.data(), a.p0.data(), a.v0.data(), scene.solver);
@@ -209,6 +260,15 @@ void check_hessian_pattern(const Lagrangian& lagrangian) {
                         lagrangian.origin());
 }
 
+const Eigen::VectorXd& written_momentum(Assembly& a, const Eigen::VectorXd& q, const Eigen::VectorXd& p,
+                                        Eigen::VectorXd& out) {
+  if (!a.orthogonal_momentum) return p;
+  out.resize(p.size());
+  a.orthogonal_momentum->correction(q.data(), p.data(), out.data());
+  out += p;
+  return out;
+}
+
 bool has_exact_solution(const Assembly& a) { return a.forces.empty() && a.lagrangian->has_exact_solution(); }
 
 Assembly assemble(const Scene& scene, Registry& registry) {
@@ -219,12 +279,13 @@ Assembly assemble(const Scene& scene, Registry& registry) {
   check_structure_served(scene, *a.manifold);
   check_initial_state(scene, *a.manifold, scene.manifold.type);
   a.lagrangian = make_part<Lagrangian>(registry, scene.lagrangian, scene, *a.manifold);
+  serve_in_embedding(registry, a);
   check_declared_sizes(*a.lagrangian);
   check_lagrangian_fits(scene, *a.lagrangian, *a.manifold);
   check_momentum_size(*a.lagrangian, a.manifold->dim());
   check_hessian_pattern(*a.lagrangian);
   check_dense_size(scene, *a.lagrangian);
-  check_observables(scene, *a.lagrangian, *a.manifold);
+  check_observables(scene, *a.lagrangian, a.embedded ? *a.embedded : *a.manifold);
   create_forces(scene, registry, a);
   create_constraints(scene, registry, a);
   scene.construction->build(scene, registry, a);

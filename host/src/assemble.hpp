@@ -25,13 +25,20 @@ class Registry;
 // The assembled integrator. Members are declared so that the map, which refers to the plugin
 // objects, is destroyed before them.
 struct Assembly {
+  // The manifold the constructions serve: the scene's, or R^point_size where the scene's is served
+  // in its embedding (Manifold::defining_constraint; then `embedded` holds the scene's).
   std::shared_ptr<Manifold> manifold;
+  std::shared_ptr<Manifold> embedded;
   std::shared_ptr<Lagrangian> lagrangian;
   std::shared_ptr<Quadrature> quadrature;  // when the construction uses one
   std::shared_ptr<OneStepMethod> one_step;  // when the construction uses one
   std::vector<std::shared_ptr<Force>> forces;  // system.forces
   std::vector<std::shared_ptr<Constraint>> constraints;  // system.constraints, bound to the system
   std::unique_ptr<HolonomicConstraints> holonomic;  // them as one g (null without constraints)
+  // On an embedded manifold a momentum is read and written as the covector orthogonal to the
+  // normals G(q)^T (S2: q . p = 0), which the constructions hold as M v (G M^-1 p = 0): this
+  // projection (CotangentProjection with M = I) forms the written one; null elsewhere.
+  std::unique_ptr<CotangentProjection> orthogonal_momentum;
   std::unique_ptr<DiscreteHamiltonianMap> map;
   DiscreteLagrangian* discrete_lagrangian = nullptr;  // when the construction has one (in `map`)
   bool one_step_symplectic = false;  // what the one-step plugin declares (its "symplectic" property)
@@ -39,6 +46,10 @@ struct Assembly {
   double t0 = 0.0;
   Eigen::VectorXd v0;  // set when the scene gives v or observes energy or momentum
 };
+
+// The momentum p at q as written (Assembly::orthogonal_momentum): p itself, or into `out`.
+const Eigen::VectorXd& written_momentum(Assembly& a, const Eigen::VectorXd& q, const Eigen::VectorXd& p,
+                                        Eigen::VectorXd& out);
 
 // Whether the whole system, Lagrangian and forces, has a closed-form solution: only then do
 // `verify` and `cost` measure against it; otherwise against a reference run of the same system.

@@ -140,7 +140,7 @@ Truth reference_truth(const Method& m, const std::deque<Method>& methods, Regist
   const double t_end = final_time(m.scene), target = 1e-12 * std::max(1.0, m.assembly.q0.lpNorm<Eigen::Infinity>());
   try {
     // Galerkin of degree 4 with 4 Gauss-Legendre points: order 8, far above the orders it checks.
-    Assembly reference = assemble(galerkin_reference(m.scene, 4, 4), registry);
+    Assembly reference = assemble(galerkin_reference(m.scene, m.assembly, 4, 4), registry);
     return converge(reference, t_end, h_min / 2, target,
                     "reference run: galerkin degree 4, gauss-legendre 4 points (order 8)");
   } catch (const std::invalid_argument&) {

@@ -49,8 +49,10 @@ struct Failure {
 
 
 // Spec "Outputs": the run record's keys.
-json run_record(const Scene& scene, const Assembly& a, const Observer& observer, const Trajectory& state,
+json run_record(const Scene& scene, Assembly& a, const Observer& observer, const Trajectory& state,
                 const RunOutcome& outcome, const Registry& registry) {
+  Eigen::VectorXd written;
+  const Eigen::VectorXd& p = written_momentum(a, state.q(), state.p(), written);
   const auto& statistics = a.map->solver_statistics();
   const auto& evaluations = a.map->evaluations();
   json record{
@@ -62,7 +64,7 @@ json run_record(const Scene& scene, const Assembly& a, const Observer& observer,
         {"gradient", evaluations.gradient},
         {"hessian", evaluations.hessian},
         {"force", evaluations.force}}},
-      {"final", {{"t", state.t()}, {"q", as_vector(state.q())}, {"p", as_vector(state.p())}}},
+      {"final", {{"t", state.t()}, {"q", as_vector(state.q())}, {"p", as_vector(p)}}},
   };
   if (scene.observe.energy) record["energy_error_max"] = observer.energy_error();
   if (scene.observe.momentum) record["momentum_error_max"] = observer.momentum_error();
@@ -79,7 +81,7 @@ void print_human_summary(std::FILE* to, const Scene& scene, const Assembly& a, c
                          const Trajectory& state, const RunOutcome& outcome) {
   const auto& statistics = a.map->solver_statistics();
   const std::string method = scene.construction->describe(scene);
-  fmt::print(to, "system            {} on {}\n", scene.lagrangian.type, scene.manifold.type);
+  fmt::print(to, "system            {} on {}\n", scene.lagrangian.type, manifold_name(scene.manifold));
   fmt::print(to, "method            {}, h = {}\n", method, scene.step);
   fmt::print(to, "steps             {}\n", state.steps());
   fmt::print(to, "final time        {:.10g}\n", state.t());
@@ -286,23 +288,24 @@ class Stepper {
   void observe_and_write() {
     const long k = trajectory_.steps();
     const Eigen::VectorXd& q = trajectory_.q();
-    const Eigen::VectorXd& p = trajectory_.p();
-    observer_.observe(q.data(), p.data());
+    const Eigen::VectorXd& held = trajectory_.p();
+    observer_.observe(q.data(), held.data());
     // Never a non-finite number in the trajectory: an observable that overflows (energy of a
     // finite but huge state) ends the run like a non-finite state does.
     const auto& values = observer_.values();
     for (std::size_t i = 0; i < values.size(); ++i)
       if (!std::isfinite(values[i]))
         throw NumericalFailure(fmt::format("a non-finite {} ({})", observer_.columns()[i], values[i]), std::nan(""));
-    if (energy_range_due(k)) observer_.check_energy_range(q.data(), p.data());
+    if (energy_range_due(k)) observer_.check_energy_range(q.data(), held.data());
     const bool due = k % scene_.output_every == 0 || k == scene_.steps;
-    if (csv_ && due)
+    if (!due) return;
+    const Eigen::VectorXd& p = written_momentum(a_, q, held, written_);
+    if (csv_)
       csv_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()),
                 values);
-    if (h5_ && due)
-      h5_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()), values);
-    if (plot_ && due) plot_->record(trajectory_.t(), q, p, values);
-    if (recorder_ != nullptr && due) recorder_->row(trajectory_.t(), q.data(), p.data(), values);
+    if (h5_) h5_->row(trajectory_.t(), q.data(), static_cast<int>(q.size()), p.data(), static_cast<int>(p.size()), values);
+    if (plot_) plot_->record(trajectory_.t(), q, p, values);
+    if (recorder_ != nullptr) recorder_->row(trajectory_.t(), q.data(), p.data(), values);
   }
 
   // The energy's sane range (Observer::check_energy_range) is checked for a system without forces
@@ -318,6 +321,7 @@ class Stepper {
 
   const Scene& scene_;
   Assembly& a_;
+  Eigen::VectorXd written_;  // the momentum as written (written_momentum), where it differs from the held
   Trajectory trajectory_;
   Observer observer_;
   RunOutcome outcome_;

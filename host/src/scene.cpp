@@ -227,10 +227,15 @@ Scene load_scene(const std::filesystem::path& file, Registry& registry, const st
 }
 
 void check_initial_state(const Scene& scene, Manifold& manifold, const std::string& manifold_type) {
-  const int point_size = manifold.point_size(), dim = manifold.dim();
+  // A manifold served in its embedding takes velocities and momenta in the embedding's numbers.
+  const int point_size = manifold.point_size(),
+            dim = manifold.defining_constraint() != nullptr ? point_size : manifold.dim();
   check_size(scene.q, point_size, "/initial/q", fmt::format("the point size of {}", manifold_type));
-  if (scene.p) check_size(*scene.p, dim, "/initial/p", fmt::format("the dimension of {}", manifold_type));
-  if (scene.v) check_size(*scene.v, dim, "/initial/v", fmt::format("the dimension of {}", manifold_type));
+  const std::string numbers = manifold.defining_constraint() != nullptr
+                                  ? fmt::format("{} in its embedding, as its points", manifold_type)
+                                  : fmt::format("the dimension of {}", manifold_type);
+  if (scene.p) check_size(*scene.p, dim, "/initial/p", numbers);
+  if (scene.v) check_size(*scene.v, dim, "/initial/v", numbers);
   char why[256] = {};
   if (!manifold.contains(scene.q.data(), why, sizeof why))
     throw InputError(fmt::format("/initial/q: expected a point of {}{}{}; found {}", manifold_type,

@@ -40,7 +40,7 @@ std::shared_ptr<Quadrature> gauss_legendre(VerifiedScene& x, int points) {
 // `points` Gauss-Legendre points, as a reference (constructions/galerkin.cpp): on a Lie group in the
 // natural chart. It is both a discrete Lagrangian and its discrete Hamiltonian map.
 Assembly reference_galerkin(VerifiedScene& x, int degree, int points) {
-  return assemble(galerkin_reference(x.scene, degree, points), x.registry);
+  return assemble(galerkin_reference(x.scene, x.a, degree, points), x.registry);
 }
 
 // ---- ld_order, global_order ----------------------------------------------------------------------
@@ -330,7 +330,7 @@ std::string reference_state(VerifiedScene& x, double T, long steps, std::vector<
     x.lagrangian.legendre(q.data(), v.data(), p.data());
     return "the exact solution";
   }
-  const Scene scene = galerkin_reference(x.scene, 4, 4);
+  const Scene scene = galerkin_reference(x.scene, x.a, 4, 4);
   Assembly reference = assemble(scene, x.registry);
   std::vector<double> qc, pc;
   within("global_order (reference)", T / steps, [&] { final_state(*reference.map, x, T / steps, steps, qc, pc); });

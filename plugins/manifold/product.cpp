@@ -5,8 +5,11 @@
 // of a product of Lie groups is the product of the factors' natural charts (q0 exp(xi) taken
 // componentwise), so its derivatives are block diagonal in the factors' variables, and so are the
 // generators of the group's action. R^n is a Lie group under addition (q exp(xi) = q + xi), so a
-// product of vector spaces and Lie groups is a Lie group; with a factor of another structure the
-// product declares the structure `product`, which the constructions refuse.
+// product of vector spaces and Lie groups is a Lie group. A product of vector spaces and manifolds
+// served in their embeddings (S2: Manifold::defining_constraint) is served in its embedding too,
+// with the factors' equations as its own (each factor's rows on its block of the point); it
+// declares the structure of a homogeneous space (of the product of the factors' groups). With any
+// other mixture the product declares the structure `product`, which the constructions refuse.
 #include <algorithm>
 #include <climits>
 #include <cstdio>
@@ -14,6 +17,7 @@
 #include <string>
 #include <vector>
 
+#include "varia/abi/constraint.hpp"
 #include "varia/abi/manifold.hpp"
 #include "varia/sdk/plugin.hpp"
 
@@ -64,6 +68,88 @@ void zero(const Derivatives& d, long k, long V) {
   if (d.hessian != nullptr) std::fill_n(d.hessian, k * V * V, 0.0);
 }
 
+// The product's equations: each embedded factor's defining constraint on its block of the point,
+// its rows after the previous factors' rows. Bound by the host to the product's point_size().
+class ProductEquations final : public varia::Constraint {
+ public:
+  void add(varia::Constraint* equations, int point_offset, int point_size) {
+    blocks_.push_back(Block{equations, point_offset, point_size});
+  }
+  bool empty() const { return blocks_.empty(); }
+  Status bind(int n, int /*space_dim*/) noexcept override {
+    return varia::sdk::guarded(error_, [&] {
+      rows_ = 0;
+      jacobian_rows_.clear();
+      jacobian_cols_.clear();
+      hessian_rows_.clear();
+      hessian_cols_.clear();
+      for (std::size_t i = 0; i < blocks_.size(); ++i) {
+        Block& b = blocks_[i];
+        if (b.point_offset + b.point_size > n) throw std::invalid_argument("the product's point has fewer numbers");
+        if (Status s = b.equations->bind(b.point_size, 0))
+          throw std::invalid_argument("factor " + std::to_string(i) + ": " + s);
+        b.first_row = rows_;
+        b.jacobian_first = static_cast<int>(jacobian_rows_.size());
+        b.hessian_first = static_cast<int>(hessian_rows_.size());
+        const int *r = nullptr, *c = nullptr;
+        b.jacobian_entries = b.equations->jacobian_pattern(&r, &c);
+        for (int e = 0; e < b.jacobian_entries; ++e) {
+          jacobian_rows_.push_back(b.first_row + r[e]);
+          jacobian_cols_.push_back(b.point_offset + c[e]);
+        }
+        b.hessian_entries = b.equations->hessian_pattern(&r, &c);
+        for (int e = 0; e < b.hessian_entries; ++e) {
+          hessian_rows_.push_back(b.point_offset + r[e]);
+          hessian_cols_.push_back(b.point_offset + c[e]);
+        }
+        rows_ += b.equations->size();
+      }
+    });
+  }
+  int size() const noexcept override { return rows_; }
+  int jacobian_pattern(const int** rows, const int** cols) const noexcept override {
+    *rows = jacobian_rows_.data();
+    *cols = jacobian_cols_.data();
+    return static_cast<int>(jacobian_rows_.size());
+  }
+  int hessian_pattern(const int** rows, const int** cols) const noexcept override {
+    *rows = hessian_rows_.data();
+    *cols = hessian_cols_.data();
+    return static_cast<int>(hessian_rows_.size());
+  }
+  Status evaluate(const double* q, double* g, double* jacobian) noexcept override {
+    return each([&](const Block& b) {
+      return b.equations->evaluate(q + b.point_offset, g != nullptr ? g + b.first_row : nullptr,
+                                   jacobian != nullptr ? jacobian + b.jacobian_first : nullptr);
+    });
+  }
+  Status weighted_hessian(const double* q, const double* lambda, double* values) noexcept override {
+    return each([&](const Block& b) {
+      return b.equations->weighted_hessian(q + b.point_offset, lambda + b.first_row, values + b.hessian_first);
+    });
+  }
+
+ private:
+  struct Block {
+    varia::Constraint* equations;
+    int point_offset, point_size;
+    int first_row = 0, jacobian_first = 0, hessian_first = 0, jacobian_entries = 0, hessian_entries = 0;
+  };
+  template <class Call>
+  Status each(Call call) noexcept {
+    for (const Block& b : blocks_)
+      if (Status s = call(b)) {
+        error_ = s;
+        return error_.c_str();
+      }
+    return nullptr;
+  }
+  std::vector<Block> blocks_;
+  int rows_ = 0;
+  std::vector<int> jacobian_rows_, jacobian_cols_, hessian_rows_, hessian_cols_;
+  std::string error_;
+};
+
 class Product final : public Manifold {
  public:
   static constexpr const char* version = "1.0.0";
@@ -103,11 +189,16 @@ class Product final : public Manifold {
     point_size_ = static_cast<int>(point_size);
     dim_ = static_cast<int>(dim);
     structure_ = structure_of(manifolds);
+    if (structure_ == ManifoldStructure::homogeneous_space)
+      for (const Factor& f : factors_)
+        if (varia::Constraint* equations = f.manifold->defining_constraint())
+          equations_.add(equations, f.point_offset, f.point_size);
   }
 
   int point_size() const noexcept override { return point_size_; }
   int dim() const noexcept override { return dim_; }
   ManifoldStructure structure() const noexcept override { return structure_; }
+  varia::Constraint* defining_constraint() noexcept override { return equations_.empty() ? nullptr : &equations_; }
 
   Status retract(const double* q0, const double* xi, double* q) noexcept override {
     return each([&](const Factor& f) {
@@ -212,14 +303,21 @@ class Product final : public Manifold {
   }
 
  private:
+  // Vector spaces and Lie groups: a Lie group (a vector space if all are); vector spaces and
+  // embedded manifolds: served in the embedding, a homogeneous space; otherwise `product`.
   static ManifoldStructure structure_of(const std::vector<Manifold*>& manifolds) {
-    bool all_vector_spaces = true;
+    int vector_spaces = 0, groups = 0, embedded = 0;
     for (Manifold* manifold : manifolds) {
       const ManifoldStructure s = manifold->structure();
-      if (s != ManifoldStructure::vector_space && s != ManifoldStructure::lie_group) return ManifoldStructure::product;
-      all_vector_spaces = all_vector_spaces && s == ManifoldStructure::vector_space;
+      if (s == ManifoldStructure::vector_space) ++vector_spaces;
+      else if (s == ManifoldStructure::lie_group) ++groups;
+      else if (manifold->defining_constraint() != nullptr) ++embedded;
     }
-    return all_vector_spaces ? ManifoldStructure::vector_space : ManifoldStructure::lie_group;
+    const int count = static_cast<int>(manifolds.size());
+    if (vector_spaces == count) return ManifoldStructure::vector_space;
+    if (vector_spaces + groups == count) return ManifoldStructure::lie_group;
+    if (vector_spaces + embedded == count) return ManifoldStructure::homogeneous_space;
+    return ManifoldStructure::product;
   }
   // Runs the factors' call in turn; the first failure, with the factor it came from.
   template <class Call>
@@ -239,6 +337,7 @@ class Product final : public Manifold {
   std::vector<Factor> factors_;
   int point_size_ = 0, dim_ = 0;
   ManifoldStructure structure_ = ManifoldStructure::product;
+  ProductEquations equations_;
   DerivativeBuffers point_buffers_, velocity_buffers_;
   std::vector<Jet2> block_;
   std::string error_;

@@ -8,7 +8,7 @@ given as generators A_k of a linear action on q (and v alike); the plugin declar
 momentum map J_k = <dL/dv, A_k q>, so that `verify` predicts momentum conservation and measures
 the invariance of L_d (a generator that is not a symmetry of L is reported as not holding). The source is
 compiled against the SDK's headers into a plugin file cached by the hash of its text (and of the
-compiler's command), and the directory holding it is put on VARIA_PLUGIN_PATH, so that later
+compiler's command and of the SDK's and the ABI's headers), and the directory holding it is put on VARIA_PLUGIN_PATH, so that later
 scenes of the process name the type.
 """
 
@@ -176,6 +176,22 @@ def _compile_command(source, target):
             source, "-o", target]
 
 
+def _headers_digest():
+    """The SDK's and the ABI's headers, hashed: a plugin compiled against other headers (another
+    ABI version, which the host refuses, or another SDK) is compiled again, not loaded from the cache."""
+    digest = hashlib.sha256()
+    for directory in _varia.sdk_include_dirs():
+        for root, dirs, files in os.walk(directory):
+            dirs.sort()
+            for name in sorted(files):
+                if name.endswith(".hpp"):
+                    path = os.path.join(root, name)
+                    digest.update(os.path.relpath(path, directory).encode() + b"\0")
+                    with open(path, "rb") as f:
+                        digest.update(f.read())
+    return digest.digest()
+
+
 _registered = {}  # type name -> the directory put on VARIA_PLUGIN_PATH for it
 
 
@@ -192,7 +208,7 @@ def lagrangian(name, L, q, v, parameters=None, symmetry=None, directory=None):
     parameters = dict(parameters or {})
     source = _source(name, sympy.sympify(L), q, v, parameters, _generators(symmetry, len(q)))
     cache = os.path.join(os.environ.get("XDG_CACHE_HOME", os.path.expanduser("~/.cache")), "varia", "lagrangians")
-    key = hashlib.sha256((source + "\0" + " ".join(_compile_command("", ""))).encode()).hexdigest()[:24]
+    key = hashlib.sha256((source + "\0" + " ".join(_compile_command("", ""))).encode() + _headers_digest()).hexdigest()[:24]
     where = os.path.join(cache, key)
     plugin = os.path.join(where, f"lagrangian_{_identifier(name)}.so")
     if not os.path.exists(plugin):

@@ -1,5 +1,6 @@
-// A manifold of a structure no construction serves yet: the unit sphere S2 in R^3 declared as a
-// homogeneous space (of SO(3)), with a retraction by normalization. The host must refuse a scene on
+// A manifold of a structure no construction serves: the unit sphere S2 in R^3 declared as a
+// homogeneous space (of SO(3)), with a retraction by normalization, but without its equation
+// (Manifold::defining_constraint, which the bundled S2 gives). The host must refuse a scene on
 // it once, at /system/manifold, whatever the construction (exit 2), not take it for a Lie group.
 #include <cmath>
 #include <cstdio>

@@ -44,7 +44,7 @@ const std::map<std::string, std::string> kBadScenes{
     {"unknown-observable.json", "/observe/0: expected one of \"energy\""},
     // unknown plugin types, listing the valid ones
     {"unknown-lagrangian.json", "/system/lagrangian/type: unknown lagrangian type 'pendulm'; valid lagrangian types are: "},
-    {"unknown-manifold.json", "/system/manifold/type: unknown manifold type 'R3'; valid manifold types are: Rn, SE3, SO3"},
+    {"unknown-manifold.json", "/system/manifold/type: unknown manifold type 'R3'; valid manifold types are: Rn, S2, SE3, SO3"},
     {"unknown-quadrature.json", "/method/quadrature/type: unknown quadrature type 'gauss'; valid quadrature types are: "},
     // out-of-range parameters
     {"bad-quadrature-parameter.json", "/method/quadrature/points: expected an integer >= 2"},

@@ -15,6 +15,7 @@
 #include "assemble.hpp"
 #include "host/support.hpp"
 #include "registry.hpp"
+#include "run.hpp"
 #include "scene.hpp"
 #include "varia/core/trajectory.hpp"
 #include "varia/core/verification.hpp"
@@ -160,6 +161,131 @@ TEST_CASE("the double spherical pendulum on two rods agrees with an independent 
   for (int k = 0; k < 6; ++k) error = std::max(error, std::abs(trajectory.q()[k] - truth[k]));
   MESSAGE("double spherical pendulum, h = 0.01, s = 2, T = 3: max |x - x_ref| = ", error);
   CHECK(error <= 1e-7);
+}
+
+namespace {
+
+json scene_file(const char* name) { return json::parse(test::read_file(test::kSourceDir / "scenes/multibody" / name)); }
+
+// pendulum-chain's positions x_i = l_1 q_1 + ... + l_i q_i, from the rods' directions q_i.
+Eigen::VectorXd chain_positions(const Eigen::VectorXd& q, const std::vector<double>& lengths) {
+  Eigen::VectorXd x(q.size());
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < lengths.size(); ++i) x.segment<3>(3 * i) = sum += lengths[i] * q.segment<3>(3 * i);
+  return x;
+}
+
+}  // namespace
+
+// Spec "S2 and products": pendulum-chain on S2 x S2 is the same motion as the composite + rods.
+TEST_CASE("pendulum-chain on S2 x S2 agrees with the double spherical pendulum's reference to 1e-7 at T = 3") {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  Assembly a = assembled(scene_file("double-spherical-pendulum-s2.json"), registry, scene);
+  const std::vector<double> lengths{1.0, 0.7};
+  const Eigen::VectorXd x0 = chain_positions(a.q0, lengths), v0 = chain_positions(a.v0, lengths);
+  State12 start(12);
+  for (int k = 0; k < 6; ++k) start[k] = x0[k], start[6 + k] = v0[k];
+  const State12 truth = double_pendulum_reference(start, 1.0, 0.5, 3.0);
+  Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, scene.step);
+  trajectory.advance(scene.steps);
+  const Eigen::VectorXd x = chain_positions(trajectory.q(), lengths);
+  double error = 0.0;
+  for (int k = 0; k < 6; ++k) error = std::max(error, std::abs(x[k] - truth[k]));
+  MESSAGE("pendulum-chain on S2 x S2, h = 0.01, s = 2, T = 3: max |x - x_ref| = ", error);
+  CHECK(error <= 1e-7);
+}
+
+// One rod of length 1 and mass 1: S2's equation (|q|^2 - 1)/2 is the rod's, and the Lagrangians are
+// equal, so the two forms take the same steps up to round-off.
+TEST_CASE("pendulum-chain on S2 takes the steps of the particle on a rod") {
+  Registry registry{Registry::search_path({})};
+  Scene sphere_scene, rod_scene;
+  Assembly sphere = assembled(scene_file("spherical-pendulum-s2.json"), registry, sphere_scene);
+  Assembly rod = assembled(scene_file("spherical-pendulum-rod-s2.json"), registry, rod_scene);
+  Trajectory on_sphere(*sphere.map, sphere.q0, sphere.p0, sphere.t0, sphere_scene.step);
+  Trajectory on_rod(*rod.map, rod.q0, rod.p0, rod.t0, rod_scene.step);
+  on_sphere.advance(1000);
+  on_rod.advance(1000);
+  const double difference = (on_sphere.q() - on_rod.q()).lpNorm<Eigen::Infinity>();
+  MESSAGE("S2 against the rod after 1000 steps: ", difference);
+  CHECK(difference <= 1e-12);
+}
+
+// Noether with the manifold's own constraint: |q_i| = 1 is invariant under rotations about e3.
+TEST_CASE("pendulum-chain on S2 x S2 keeps its vertical angular momentum to 1e-13 over 1e5 steps") {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  json document = scene_file("double-spherical-pendulum-s2.json");
+  document.erase("t_end");
+  document["steps"] = 100000;
+  document["observe"] = {"momentum", "constraint"};
+  RunOptions options;
+  options.quiet = true;
+  json record;
+  options.record = &record;
+  Assembly a = assembled(document, registry, scene);
+  run_scene(scene, a, registry, options);
+  double J0 = 0.0;
+  a.lagrangian->momentum(a.q0.data(), a.v0.data(), &J0);
+  const double relative = record["momentum_error_max"].get<double>() / std::abs(J0);
+  MESSAGE("vertical momentum ", J0, ", relative error over 1e5 steps ", relative, ", constraint ",
+          record["constraint_error_max"].get<double>());
+  CHECK(relative <= 1e-13);
+  CHECK(record["constraint_error_max"].get<double>() <= 1e-12);
+}
+
+// Spec: initial.p on S2 is dL/dq' in the ambient form with q . p = 0, and so is every written p.
+TEST_CASE("on S2 x S2 a momentum is read and written orthogonal to the normals, and restarts the same motion") {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  json document = scene_file("double-spherical-pendulum-s2.json");
+  document["t_end"] = 0.5;
+  RunOptions options;
+  options.quiet = true;
+  json record;
+  options.record = &record;
+  Assembly a = assembled(document, registry, scene);
+  run_scene(scene, a, registry, options);
+  const auto q = record["final"]["q"].get<std::vector<double>>(), p = record["final"]["p"].get<std::vector<double>>();
+  for (int i = 0; i < 2; ++i) {
+    const double along = q[3 * i] * p[3 * i] + q[3 * i + 1] * p[3 * i + 1] + q[3 * i + 2] * p[3 * i + 2];
+    CHECK(std::abs(along) <= 1e-14);
+  }
+  json restart = scene_file("double-spherical-pendulum-s2.json");
+  restart["initial"] = {{"q", q}, {"p", p}};
+  restart["t_end"] = 0.5;
+  Scene again;
+  json record_again;
+  options.record = &record_again;
+  Assembly b = assembled(restart, registry, again);
+  run_scene(again, b, registry, options);
+  json onward = scene_file("double-spherical-pendulum-s2.json");
+  onward["t_end"] = 1.0;
+  Scene whole;
+  json record_whole;
+  options.record = &record_whole;
+  Assembly c = assembled(onward, registry, whole);
+  run_scene(whole, c, registry, options);
+  const auto q1 = record_again["final"]["q"].get<std::vector<double>>(), q2 = record_whole["final"]["q"].get<std::vector<double>>();
+  for (int k = 0; k < 6; ++k) CHECK(std::abs(q1[k] - q2[k]) <= 1e-12);
+  json across = scene_file("double-spherical-pendulum-s2.json");
+  across["initial"] = {{"q", q}, {"p", {p[0] + 0.1 * q[0], p[1] + 0.1 * q[1], p[2] + 0.1 * q[2], p[3], p[4], p[5]}}};
+  CHECK_THROWS_WITH_AS(assembled(across, registry, scene), doctest::Contains("/initial/p"), InputError);
+}
+
+TEST_CASE("S2 is refused where it cannot be served, and a point off the sphere at /initial/q") {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  json shooting = scene_file("spherical-pendulum-s2.json");
+  shooting["method"] = {{"construction", "one-step"}, {"one_step", {{"type", "implicit-midpoint"}}}};
+  CHECK_THROWS_WITH_AS(assembled(shooting, registry, scene), doctest::Contains("/system/manifold"), InputError);
+  json off = scene_file("spherical-pendulum-s2.json");
+  off["initial"]["q"] = {0.85, 0, -0.54};
+  CHECK_THROWS_WITH_AS(assembled(off, registry, scene), doctest::Contains("/initial/q"), InputError);
+  json mixed = scene_file("spherical-pendulum-s2.json");
+  mixed["system"]["manifold"] = {{"type", "product"}, {"factors", {{{"type", "S2"}}, {{"type", "SO3"}}}}};
+  CHECK_THROWS_WITH_AS(assembled(mixed, registry, scene), doctest::Contains("/system/manifold"), InputError);
 }
 
 TEST_CASE("constraints are refused where they cannot be served, and a start off them is refused at its pointer") {

@@ -503,8 +503,8 @@ TEST_CASE("a manifold or a Lagrangian declaring sizes no scene can cause is a pl
         "(/plugins/lagrangian_still.so)");
 }
 
-// A manifold whose structure no construction serves yet (a homogeneous space, S2:
-// tests/fault_plugins/unserved_sphere.cpp) is refused once, at /system/manifold, by validate and
+// A manifold whose structure no construction serves (a homogeneous space that gives neither a
+// group's chart nor its equations: tests/fault_plugins/unserved_sphere.cpp) is refused once, at /system/manifold, by validate and
 // for every construction, before anything else is made of it; it is not taken for a Lie group.
 TEST_CASE("a manifold of a structure no construction serves is refused at /system/manifold, exit 2") {
   const FaultDirectory faults;
@@ -528,7 +528,7 @@ TEST_CASE("a manifold of a structure no construction serves is refused at /syste
       CAPTURE(outcome.err);
       CHECK(outcome.code == 2);
       CHECK(contains(outcome.err, "/system/manifold: the unserved-sphere manifold is a homogeneous space, and the "
-                                  "constructions serve vector spaces and Lie groups"));
+                                  "constructions serve vector spaces, Lie groups and manifolds given by their equations"));
     }
   }
 }

@@ -56,8 +56,9 @@ class Construction {
 // The reference integrator that `cost` and `verify` measure against where the system has no
 // closed-form solution: `scene` with its method replaced by a Galerkin construction of the given
 // degree with `points` Gauss-Legendre points, of order min(2 degree, 2 points) (paper, sec. 2),
-// for the same system, forces and start (galerkin.cpp).
-Scene galerkin_reference(const Scene& scene, int degree, int points);
+// for the same system, forces and start (galerkin.cpp); with constraints (the assembly `a` of
+// `scene` has them), degree + 1 Lobatto points, of order 2 degree (Jay).
+Scene galerkin_reference(const Scene& scene, const Assembly& a, int degree, int points);
 
 // The table: the construction named `name`, or an InputError at /method/construction listing the
 // available ones.

@@ -225,12 +225,14 @@ const Construction& galerkin_construction() {
   return construction;
 }
 
-Scene galerkin_reference(const Scene& scene, int degree, int points) {
+Scene galerkin_reference(const Scene& scene, const Assembly& a, int degree, int points) {
   Scene reference = scene;
-  // With constraints: Lobatto's rule of degree + 1 points, the control points at its nodes (Jay's
-  // Lobatto IIIA-IIIB equations, order 2 degree), as no theorem gives Gauss's order there.
-  const std::string rule = scene.constraints.empty() ? "gauss-legendre" : "gauss-lobatto";
-  if (!scene.constraints.empty()) points = degree + 1;
+  // With constraints (the scene's, or an embedded manifold's equations): Lobatto's rule of
+  // degree + 1 points, the control points at its nodes (Jay's Lobatto IIIA-IIIB equations, order
+  // 2 degree), as no theorem gives Gauss's order there.
+  const bool constrained = a.holonomic != nullptr;
+  const std::string rule = constrained ? "gauss-lobatto" : "gauss-legendre";
+  if (constrained) points = degree + 1;
   const json quadrature{{"type", rule}, {"points", points}};
   reference.construction = &galerkin_construction();
   reference.method_options =

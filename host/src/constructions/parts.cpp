@@ -18,7 +18,9 @@ void apply_shared_theorems(const Assembly& a, std::optional<bool> ld_invariant, 
     p.g_invariant = ld_invariant;
     if (ld_invariant.value_or(false)) p.momentum_conserved = true;
   }
-  if (a.holonomic && (p.g_invariant || p.momentum_conserved)) {
+  // An embedded manifold's own equations hold wherever its symmetry's action takes a point of it
+  // (the action maps the manifold to itself): only the scene's constraints void the prediction.
+  if (!a.constraints.empty() && (p.g_invariant || p.momentum_conserved)) {
     p.g_invariant.reset();
     p.momentum_conserved.reset();
     p.reason += "; with constraints a symmetry of L need not be one of g: G-invariance and momentum not predicted";

@@ -13,6 +13,7 @@
 // templated on the scalar, and the SDK's adapter (varia/sdk/lie_group.hpp) derives these.
 #pragma once
 
+#include "varia/abi/constraint.hpp"
 #include "varia/abi/jet.hpp"
 #include "varia/abi/plugin_object.hpp"
 
@@ -60,6 +61,14 @@ class Manifold : public PluginObject {
   // valid (has_constraint() false).
   virtual double constraint_error(const double* /*q*/) const noexcept { return 0.0; }
   virtual bool has_constraint() const noexcept { return false; }
+  // A manifold embedded in R^point_size() as the zero set of equations g(q) = 0 (S2: |q|^2 = 1)
+  // may give them as a holonomic constraint (abi/constraint.hpp), the manifold's own object: the
+  // host binds it to point_size() coordinates, and the constructions then serve the manifold in
+  // its embedding, as R^point_size() with the equations' multipliers (the constrained discrete
+  // Euler-Lagrange equations, docs/constraints.md); velocities and momenta are then point_size()
+  // numbers, a momentum given as the covector orthogonal to the normals G(q)^T. Null (the
+  // default) where the manifold is served in its natural chart. ABI 17.
+  virtual Constraint* defining_constraint() noexcept { return nullptr; }
   // The natural chart to second order, for the Galerkin construction on a Lie group (paper,
   // sec. 2, "Natural charts"): with n = dim(),
   //   point:    q0 exp(eta) exp(xi) at eta = 0, point_size() components in the 2n variables

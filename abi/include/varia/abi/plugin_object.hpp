@@ -28,7 +28,8 @@ namespace varia {
 // add without changing the layout of any interface (varia_create_parts, for parts) are not new
 // versions either: a plugin that lacks one keeps loading, and is refused only where it is needed.
 // 16: the constraint kind (constraint.hpp, Kind::constraint); Lagrangian::space_dim.
-inline constexpr int kAbiVersion = 16;
+// 17: Manifold::defining_constraint (an embedded manifold served with its equations' multipliers).
+inline constexpr int kAbiVersion = 17;
 
 using Status = const char*;
 

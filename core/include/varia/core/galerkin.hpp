@@ -155,7 +155,6 @@ class GalerkinDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void constrained_newton(double h, int first_unknown, int first_equation, int blocks, const double* p0, bool forced);
   void prepare_bordered(int first_unknown, int first_equation, int blocks);
   void project_momentum(const double* p0);
-  std::vector<Eigen::Triplet<double>> mass_entries(const double* q);
   // Simplified Newton for a constant mass matrix, in the nodes' coordinates (see the top):
   // whether it applies (and its linear maps, formed once), the extrapolation of the last steps'
   // forces to the next step's nodes, the fixed point as a NewtonSolver system, its solve (true when

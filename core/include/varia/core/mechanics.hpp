@@ -109,4 +109,10 @@ class LagrangianEvaluator {
   NewtonSolver legendre_solver_;
 };
 
+// The stored entries (row, col, value) of a constant mass matrix M = d2L/dv2 (n x n): a dense
+// Lagrangian's constant_mass_matrix, a sparse one's Hessian's velocity block at q (with v = 0;
+// constant, so any point gives it). Throws std::invalid_argument where a dense Lagrangian
+// declares none. For the constraints' projections (constraints.hpp) and the sparse explicit form.
+std::vector<Eigen::Triplet<double>> constant_mass_entries(LagrangianEvaluator& evaluator, const double* q);
+
 }  // namespace varia

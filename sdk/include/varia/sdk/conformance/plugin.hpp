@@ -22,8 +22,8 @@
 
 namespace varia::sdk::conformance {
 
-// The contexts a Lagrangian plugin may accept: Rn with dim 1 to 8, SO3, SE3 and the products of
-// one and two SO3.
+// The contexts a Lagrangian plugin may accept: Rn with dim 1 to 8, SO3, SE3, the products of one
+// and two SO3, S2 and the product of two S2 (served in the embedding: velocities of 3 numbers each).
 inline std::vector<nlohmann::json> lagrangian_contexts() {
   std::vector<nlohmann::json> contexts;
   for (int n = 1; n <= 8; ++n) contexts.push_back({{"manifold", "Rn"}, {"point_size", n}, {"dim", n}});
@@ -31,6 +31,8 @@ inline std::vector<nlohmann::json> lagrangian_contexts() {
   contexts.push_back({{"manifold", "SE3"}, {"point_size", 12}, {"dim", 6}});
   contexts.push_back({{"manifold", "product(SO3)"}, {"point_size", 9}, {"dim", 3}});
   contexts.push_back({{"manifold", "product(SO3,SO3)"}, {"point_size", 18}, {"dim", 6}});
+  contexts.push_back({{"manifold", "S2"}, {"point_size", 3}, {"dim", 2}});
+  contexts.push_back({{"manifold", "product(S2,S2)"}, {"point_size", 6}, {"dim", 4}});
   return contexts;
 }
 
@@ -73,7 +75,7 @@ inline void check_lagrangian_plugin(const LoadedPlugin& plugin, Failures& failur
                       "the schema's defaults are not the defaults of the constructor");
     for (const auto& failure : in_context.list()) failures.expect(false, context.dump(), ": ", failure);
   }
-  failures.expect(accepted > 0, "no context accepted with default parameters (Rn of dim 1 to 8, SO3, SE3, products of SO3)");
+  failures.expect(accepted > 0, "no context accepted with default parameters (Rn of dim 1 to 8, SO3, SE3, products of SO3, S2, S2 x S2)");
 }
 
 // The parameter objects an effect or force is made with: the schema's "examples" (draft-07), or
