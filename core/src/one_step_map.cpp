@@ -9,7 +9,17 @@ namespace {
 // The Euler-Lagrange field the method integrates: on a Lie group the Euler-Poincare field in
 // (g, xi); on R^n in (q, v) for a constant mass matrix, else Hamilton's equations in (q, p)
 // (mechanical_field.hpp), where a symplectic Runge-Kutta method is symplectic.
-std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvaluator& lagrangian) {
+std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvaluator& lagrangian,
+                                             const OneStepMethod& method, HolonomicConstraints* constraints) {
+  if (constraints != nullptr) {
+    if (!manifold.is_vector_space() || method.explicit_tableau().stages == 0)
+      throw std::invalid_argument(
+          "with constraints the one-step construction takes explicit Runge-Kutta methods on vector spaces only (the "
+          "constrained field has no Jacobian for implicit stages: its multiplier's derivatives need the constraints' "
+          "third derivatives)");
+    require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");
+    return std::make_unique<ConstrainedField>(lagrangian, *constraints);
+  }
   if (!manifold.is_vector_space()) return std::make_unique<LieGroupField>(manifold, lagrangian);
   require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");
   return std::make_unique<MechanicalField>(
@@ -19,10 +29,12 @@ std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvalu
 }  // namespace
 
 OneStepHamiltonianMap::OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian,
-                                             OneStepMethod& method, SolverOptions options)
+                                             OneStepMethod& method, SolverOptions options,
+                                             HolonomicConstraints* constraints)
     : manifold_(manifold),
       lagrangian_(lagrangian),
-      field_(field_of(manifold, lagrangian_)),
+      field_(field_of(manifold, lagrangian_, method, constraints)),
+      constrained_(constraints != nullptr ? static_cast<ConstrainedField*>(field_.get()) : nullptr),
       method_(method),
       m_(manifold.point_size()),
       n_(manifold.dim()),
@@ -46,6 +58,7 @@ void OneStepHamiltonianMap::take_step(const double* q0, const double* p0, double
     y0_.tail(n_) = Eigen::Map<const Eigen::VectorXd>(p0, n_);
   }
   field_->step(method_, h, y0_.data(), y1_.data(), statistics_);
+  if (constrained_ != nullptr) constrained_->project(y1_.data(), y1_.data() + m_, options_);
   Eigen::Map<Eigen::VectorXd>(q1, m_) = y1_.head(m_);
   if (field_->constant_mass()) Eigen::Map<Eigen::VectorXd>(p1, n_).noalias() = field_->mass() * y1_.tail(n_);
   else if (tangent_) lagrangian_.legendre(q1, y1_.data() + m_, p1);
@@ -53,6 +66,8 @@ void OneStepHamiltonianMap::take_step(const double* q0, const double* p0, double
 }
 
 std::string OneStepHamiltonianMap::tangent_map_refusal() const {
+  if (constrained_ != nullptr)
+    return "the one-step construction with constraints projects each step onto them, and has no tangent map";
   if (!lagrangian_.plugin().evaluates_at_jets())
     return "the one-step construction's tangent map steps jets, and this Lagrangian does not evaluate at jets";
   return {};

@@ -48,8 +48,8 @@ void create_constraints(const Scene& scene, Registry& registry, Assembly& a) {
                                              scene.manifold.type)
                                : "constraints are";
   if (!scene.construction->takes_constraints(a.manifold->structure()))
-    throw InputError(fmt::format("{}: {} taken by the galerkin construction on vector spaces (docs/constraints.md), "
-                                 "not by '{}' on the {} manifold",
+    throw InputError(fmt::format("{}: {} taken by the galerkin and one-step constructions on vector spaces "
+                                 "(docs/constraints.md), not by '{}' on the {} manifold",
                                  pointer, what, scene.construction->name(), scene.manifold.type));
   if (!has_constant_mass_matrix(*a.lagrangian))
     throw InputError(fmt::format("{}: constraints need a Lagrangian with a constant mass matrix (the momenta's "

@@ -27,15 +27,19 @@ using nlohmann::json;
 using State6 = std::array<double, 6>;
 constexpr double kGravity = 9.81;
 
-json spherical_pendulum(int degree, double h, long steps) {
+json galerkin_lobatto(int degree) {
+  return {{"construction", "galerkin"}, {"degree", degree}, {"quadrature", {{"type", "gauss-lobatto"}, {"points", degree + 1}}}};
+}
+
+json spherical_pendulum(const json& method, double h, long steps) {
   json document = json::parse(test::read_file(test::kSourceDir / "scenes/multibody/spherical-pendulum-rod-s1.json"));
-  document["method"] = {{"construction", "galerkin"}, {"degree", degree},
-                        {"quadrature", {{"type", "gauss-lobatto"}, {"points", degree + 1}}}};
+  document["method"] = method;
   document["step"] = h;
   document.erase("t_end");
   document["steps"] = steps;
   return document;
 }
+json spherical_pendulum(int degree, double h, long steps) { return spherical_pendulum(galerkin_lobatto(degree), h, steps); }
 
 Assembly assembled(const json& document, Registry& registry, Scene& scene) {
   scene = parse_scene(document);
@@ -64,34 +68,54 @@ State6 reference_state(const State6& start, double T) {
   return integrated(start, field, T);
 }
 
+// The spherical pendulum on a rod under `method` at four step sizes halving from h0 to T = 1: the
+// largest errors in q and p against the RKF7(8) reference, and the order fitted to them.
+OrderFit spherical_pendulum_order(const json& method, double h0) {
+  Registry registry{Registry::search_path({})};
+  const double T = 1.0;
+  std::vector<double> hs, errors;
+  State6 truth{};
+  for (double h = h0; hs.size() < 4; h /= 2) {
+    Scene scene;
+    Assembly a = assembled(spherical_pendulum(method, h, std::lround(T / h)), registry, scene);
+    if (hs.empty()) {
+      for (int k = 0; k < 3; ++k) truth[k] = a.q0[k], truth[3 + k] = a.v0[k];
+      truth = reference_state(truth, T);
+    }
+    Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, h);
+    trajectory.advance(scene.steps);
+    double error = 0.0;  // m = 1: p = x'
+    for (int k = 0; k < 3; ++k)
+      error = std::max({error, std::abs(trajectory.q()[k] - truth[k]), std::abs(trajectory.p()[k] - truth[3 + k])});
+    hs.push_back(h);
+    errors.push_back(error);
+  }
+  const OrderFit fit = fit_order(hs, errors, 1e-12);
+  MESSAGE(method.dump(), ": errors ", errors[0], " .. ", errors[3], ", fitted order ", fit.slope, " on ", fit.used,
+          " points");
+  return fit;
+}
+
 }  // namespace
 
 TEST_CASE("the spherical pendulum on a rod: Galerkin s = 1, 2, 3 with s + 1 Lobatto points has orders 2, 4, 6") {
-  Registry registry{Registry::search_path({})};
-  const double T = 1.0;
   for (int s = 1; s <= 3; ++s) {
     CAPTURE(s);
-    std::vector<double> hs, errors;
-    State6 truth{};
-    for (double h = std::array<double, 3>{0.02, 0.05, 0.1}[s - 1]; hs.size() < 4; h /= 2) {
-      Scene scene;
-      Assembly a = assembled(spherical_pendulum(s, h, std::lround(T / h)), registry, scene);
-      if (hs.empty()) {
-        for (int k = 0; k < 3; ++k) truth[k] = a.q0[k], truth[3 + k] = a.v0[k];
-        truth = reference_state(truth, T);
-      }
-      Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, h);
-      trajectory.advance(scene.steps);
-      double error = 0.0;  // m = 1: p = x'
-      for (int k = 0; k < 3; ++k)
-        error = std::max({error, std::abs(trajectory.q()[k] - truth[k]), std::abs(trajectory.p()[k] - truth[3 + k])});
-      hs.push_back(h);
-      errors.push_back(error);
-    }
-    const OrderFit fit = fit_order(hs, errors, 1e-12);
-    MESSAGE("s = ", s, ": errors ", errors[0], " .. ", errors[3], ", fitted order ", fit.slope, " on ", fit.used, " points");
+    const OrderFit fit = spherical_pendulum_order(galerkin_lobatto(s), std::array<double, 3>{0.02, 0.05, 0.1}[s - 1]);
     CHECK(fit.used == 4);
     CHECK(std::abs(fit.slope - 2 * s) <= 0.25);
+  }
+}
+
+// The one-step methods with constraints: the index-1 equations, each step projected onto the rod
+// and its hidden constraint, keep the method's order (HLW sec. IV.4).
+TEST_CASE("the spherical pendulum on a rod: projected explicit midpoint and rk4 have orders 2 and 4") {
+  const std::pair<const char*, int> methods[] = {{"explicit-midpoint", 2}, {"rk4", 4}};
+  for (const auto& [type, order] : methods) {
+    CAPTURE(type);
+    const OrderFit fit = spherical_pendulum_order({{"construction", "one-step"}, {"one_step", {{"type", type}}}}, 0.02);
+    CHECK(fit.used == 4);
+    CHECK(std::abs(fit.slope - order) <= 0.25);
   }
 }
 
@@ -278,7 +302,7 @@ TEST_CASE("S2 is refused where it cannot be served, and a point off the sphere a
   Registry registry{Registry::search_path({})};
   Scene scene;
   json shooting = scene_file("spherical-pendulum-s2.json");
-  shooting["method"] = {{"construction", "one-step"}, {"one_step", {{"type", "implicit-midpoint"}}}};
+  shooting["method"] = {{"construction", "shooting"}, {"one_step", {{"type", "rk4"}}}, {"quadrature", {{"type", "simpson"}}}};
   CHECK_THROWS_WITH_AS(assembled(shooting, registry, scene), doctest::Contains("/system/manifold"), InputError);
   json off = scene_file("spherical-pendulum-s2.json");
   off["initial"]["q"] = {0.85, 0, -0.54};
@@ -292,8 +316,12 @@ TEST_CASE("constraints are refused where they cannot be served, and a start off 
   Registry registry{Registry::search_path({})};
   Scene scene;
   json shooting = spherical_pendulum(1, 0.01, 10);
-  shooting["method"] = {{"construction", "one-step"}, {"one_step", {{"type", "implicit-midpoint"}}}};
+  shooting["method"] = {{"construction", "shooting"}, {"one_step", {{"type", "rk4"}}}, {"quadrature", {{"type", "simpson"}}}};
   CHECK_THROWS_WITH_AS(assembled(shooting, registry, scene), doctest::Contains("/system/constraints"), InputError);
+  json implicit = spherical_pendulum(1, 0.01, 10);
+  implicit["method"] = {{"construction", "one-step"}, {"one_step", {{"type", "implicit-midpoint"}}}};
+  CHECK_THROWS_WITH_AS(assembled(implicit, registry, scene), doctest::Contains("/method/one_step: with constraints"),
+                       InputError);
   json off = spherical_pendulum(1, 0.01, 10);
   off["initial"]["q"] = {0.85, 0, -0.54};
   CHECK_THROWS_WITH_AS(assembled(off, registry, scene), doctest::Contains("/initial/q"), InputError);

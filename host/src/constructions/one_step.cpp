@@ -23,9 +23,21 @@ class OneStep final : public Construction {
 
   std::shared_ptr<const MethodOptions> read(const json&) const override { return std::make_shared<MethodOptions>(); }
 
+  // With constraints (docs/constraints.md): the index-1 equations and the projection after each step,
+  // for explicit Runge-Kutta methods (core/constrained_field.hpp).
+  bool takes_constraints(ManifoldStructure structure) const override {
+    return structure == ManifoldStructure::vector_space;
+  }
+
   void build(const Scene& scene, Registry& registry, Assembly& a) const override {
     make_one_step(scene, registry, a);
-    a.map = std::make_unique<OneStepHamiltonianMap>(*a.manifold, *a.lagrangian, *a.one_step, scene.solver);
+    try {
+      a.map = std::make_unique<OneStepHamiltonianMap>(*a.manifold, *a.lagrangian, *a.one_step, scene.solver,
+                                                      a.holonomic.get());
+    } catch (const std::invalid_argument& e) {
+      if (!a.holonomic) throw;
+      throw InputError(std::string("/method/one_step: ") + e.what());
+    }
   }
 
   // What the method declares: its order, self-adjointness and symplecticity; a symplectic method
@@ -42,6 +54,14 @@ class OneStep final : public Construction {
     if (symplectic) p.energy_bounded = true;
     if (declares_symmetry(*a.lagrangian) && symplectic && method.equivariant) p.momentum_conserved = true;
     p.reason = "one-step method: its declared order, self-adjointness and symplecticity (no L_d)";
+    if (a.holonomic) {
+      p.symplectic = false;
+      p.energy_bounded.reset();
+      p.momentum_conserved.reset();
+      p.reason += "; with constraints the method integrates their index-1 form and each step is projected onto the "
+                  "constraint and its hidden constraint (Hairer, Lubich & Wanner, sec. IV.4, standard projection): "
+                  "the order is kept, the map is not symplectic, and no conservation is predicted";
+    }
     if (method.symplectic && !symplectic)
       p.reason += "; its symplecticity is for canonical coordinates, and on a Lie group it integrates in the "
                   "embedding: predicted not symplectic";

@@ -4,7 +4,10 @@
 // of Psi_h on TQ, then p1 = M v1. Not variational unless the method is symplectic. On R^n the
 // field is the MechanicalField; on a Lie group the Euler-Poincare field (lie_group_field.hpp),
 // y = (g, xi): Runge-Kutta methods integrate it in the embedding (R^9 x R^3 on SO(3)), Lie group
-// methods on the group (paper, sec. 2, Figure 1: RK, SRK, LGM).
+// methods on the group (paper, sec. 2, Figure 1: RK, SRK, LGM). With holonomic constraints (on R^n,
+// a constant mass matrix, an explicit Runge-Kutta method) the method integrates their index-1
+// form and each step is projected onto the constraint and its hidden constraint
+// (constrained_field.hpp).
 #pragma once
 
 #include <Eigen/Core>
@@ -15,6 +18,7 @@
 
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/abi/manifold.hpp"
+#include "varia/core/constrained_field.hpp"
 #include "varia/core/mechanical_field.hpp"
 #include "varia/core/mechanics.hpp"
 #include "varia/abi/one_step.hpp"
@@ -24,9 +28,11 @@ namespace varia {
 class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
  public:
   // Throws std::invalid_argument unless the Lagrangian matches the manifold (a vector space or a
-  // Lie group) and the field can be formed (lie_group_field.hpp, mechanical_field.hpp).
+  // Lie group) and the field can be formed (lie_group_field.hpp, mechanical_field.hpp), and with
+  // constraints unless the manifold is a vector space and the method an explicit Runge-Kutta
+  // method (constrained_field.hpp).
   OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian, OneStepMethod& method,
-                        SolverOptions options);
+                        SolverOptions options, HolonomicConstraints* constraints = nullptr);
   int point_size() const override { return m_; }
   int dim() const override { return n_; }
   // Empty where the Lagrangian evaluates at jets (on R^n and on a Lie group).
@@ -55,6 +61,7 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
   Manifold& manifold_;
   LagrangianEvaluator lagrangian_;
   std::unique_ptr<EulerLagrangeField> field_;
+  ConstrainedField* constrained_ = nullptr;  // field_, with constraints
   OneStepMethod& method_;
   int m_, n_;  // point size, dimension
   // The state is (q, xi) with the momenta converted by the Legendre transform where the field is in
