@@ -16,7 +16,8 @@ ConstrainedField::ConstrainedField(LagrangianEvaluator& lagrangian, HolonomicCon
       lambda_(m_),
       rhs_(m_),
       unit_(Eigen::VectorXd::Zero(m_)),
-      g_(m_) {
+      g_(m_),
+      curvature_(n_) {
   if (!constant_mass_)
     throw std::invalid_argument("constraints need a Lagrangian with a constant mass matrix");
 }
@@ -43,7 +44,8 @@ Status ConstrainedField::eval(const double* y, double* f) noexcept {
     for (int i = 0; i < m_; ++i) {
       unit_[i] = 1.0;
       constraints_.evaluate_hessian(y, unit_.data());
-      rhs_[i] += v.dot(constraints_.hessian() * v);
+      curvature_.noalias() = constraints_.hessian() * v;
+      rhs_[i] += v.dot(curvature_);
       unit_[i] = 0.0;
     }
     lambda_ = S_factor_.solve(rhs_);

@@ -5,6 +5,8 @@
 #include <doctest/doctest.h>
 
 #include <Eigen/Core>
+#include <algorithm>
+#include <cmath>
 #include <cstddef>
 
 #include "core/fixtures.hpp"
@@ -65,6 +67,41 @@ long allocations_of_stepping(DiscreteHamiltonianMap& map, Eigen::VectorXd q, Eig
   });
 }
 
+// A unit sphere in R^3 as one holonomic constraint, g = (|q|^2 - 1)/2.
+struct UnitSphere final : Constraint {
+  Status bind(int, int) noexcept override { return nullptr; }
+  int size() const noexcept override { return 1; }
+  int jacobian_pattern(const int** rows, const int** cols) const noexcept override {
+    static constexpr int r[3] = {0, 0, 0}, c[3] = {0, 1, 2};
+    *rows = r;
+    *cols = c;
+    return 3;
+  }
+  int hessian_pattern(const int** rows, const int** cols) const noexcept override {
+    static constexpr int c[3] = {0, 1, 2};
+    *rows = c;
+    *cols = c;
+    return 3;
+  }
+  Status evaluate(const double* q, double* g, double* G) noexcept override {
+    if (g != nullptr) g[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] - 1.0);
+    if (G != nullptr) std::copy_n(q, 3, G);
+    return nullptr;
+  }
+  Status weighted_hessian(const double*, const double* lambda, double* values) noexcept override {
+    std::fill_n(values, 3, lambda[0]);
+    return nullptr;
+  }
+};
+
+// A unit mass in gravity along -e3, L = |v|^2/2 - q3, on R^3.
+struct FallingMass : sdk::AutodiffLagrangian<FallingMass, 3, 3> {
+  template <class T>
+  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
+    return 0.5 * (v(0) * v(0) + v(1) * v(1) + v(2) * v(2)) - q(2);
+  }
+};
+
 // 50 steps by step() and 50 by advance() on R^n.
 long allocations_of_steps(GalerkinDiscreteLagrangian& map, int n) {
   return allocations_of_stepping(map, Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), Eigen::VectorXd::Zero(n), 0.1, 50, true);
@@ -75,6 +112,18 @@ long allocations_of_steps(GalerkinDiscreteLagrangian& map, int n) {
 TEST_CASE("allocations are counted: resizing a dynamic vector allocates") {
   Eigen::VectorXd v;
   CHECK(allocations_of([&] { v.resize(1000); }) >= 1);
+}
+
+TEST_CASE("one-step rk4 with a constraint (the index-1 field, then the projection) allocates nothing per step") {
+  FlatSpace space(3);
+  FallingMass mass;
+  UnitSphere sphere;
+  HolonomicConstraints constraints({&sphere}, 3);
+  sdk::RungeKutta method = rk4();
+  OneStepHamiltonianMap map(space, mass, method, SolverOptions{}, &constraints);
+  const Eigen::VectorXd q = (Eigen::VectorXd(3) << std::sin(1.0), 0.0, -std::cos(1.0)).finished();
+  const Eigen::VectorXd p = (Eigen::VectorXd(3) << 0.0, 2.5, 0.0).finished();
+  CHECK(allocations_of_stepping(map, q, p, 0.01, 50) == 0);
 }
 
 // The same pendulums not declaring their mass matrix: Newton with the exact Jacobian.

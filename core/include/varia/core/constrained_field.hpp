@@ -46,7 +46,7 @@ class ConstrainedField final : public EulerLagrangeField {
   int m_;
   Eigen::MatrixXd W_, S_;
   Eigen::LLT<Eigen::MatrixXd> S_factor_;
-  Eigen::VectorXd gradient_, lambda_, rhs_, unit_, g_;
+  Eigen::VectorXd gradient_, lambda_, rhs_, unit_, g_, curvature_;  // curvature_: H_i v
 };
 
 }  // namespace varia
