@@ -10,6 +10,7 @@ packages=(
   clang libclang-rt-14-dev  # the scene fuzzer (ctest -L fuzz): libFuzzer
   gfortran  # bench_gni: the GNI peer (../shared/peers/gni) it times varia against
   pybind11-dev python3-dev python3-numpy python3-sympy python3-matplotlib  # the Python module (docs/python.md), for /usr/bin/python3
+  python3-h5py  # reading ensembles from Python (docs/ensembles.md)
 )
 missing=()
 for p in "${packages[@]}"; do

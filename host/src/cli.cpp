@@ -195,7 +195,7 @@ void define_ensemble(CLI::App& app, Options& o, Command& chosen) {
       app, o, "ensemble",
       "Run one member per element of the product of the --vary specs (the first slowest), each the scene with "
       "its values set at their JSON pointers, run as `varia run` runs it, on --threads threads or, under "
-      "mpirun -n K, across K processes (rank 0 also hands members out and writes the file). FILE.h5 holds datasets "
+      "mpirun -n K, across K processes of --threads threads each (rank 0 also hands members out and writes the file). FILE.h5 holds datasets "
       "parameters, status (each member's own exit code; -1: not run yet), final_t, final_q, final_p and one per "
       "run-record number (energy_error_max, megno_final, ...), and the scene and specs as attributes "
       "(docs/ensembles.md). A member that fails is recorded and the rest run; --resume runs only the members the "
@@ -210,7 +210,7 @@ void define_ensemble(CLI::App& app, Options& o, Command& chosen) {
   ensemble->add_option("--out", o.ensemble_out, "the ensemble's HDF5 file (a name ending in .h5)")
       ->required()
       ->type_name("FILE.h5");
-  ensemble->add_option("--threads", o.ensemble.threads, "members run at once in this process (default 1)")
+  ensemble->add_option("--threads", o.ensemble.threads, "members run at once in each process (default 1)")
       ->type_name("N");
   ensemble->add_flag("--resume", o.ensemble.resume, "run only the members FILE.h5 does not hold yet");
   ensemble->add_option("--plot", o.ensemble_plot,

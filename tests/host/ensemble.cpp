@@ -112,6 +112,23 @@ TEST_CASE("an ensemble of 32 members on 2 threads and under mpirun -n 3 gives id
   }
 }
 
+// Threads within processes: mpirun -n 2 with --threads 2 (rank 0's two threads and the other
+// process's two, fed by its main thread) gives the same dataset as threads alone.
+TEST_CASE("an ensemble under mpirun -n 2 with 2 threads a process gives the dataset of 2 threads") {
+  TempDir dir;
+  const auto threads = run_varia("ensemble " + kScene + kVaries + "--quiet --threads 2 --out '" +
+                                 (dir / "threads.h5").string() + "'");
+  REQUIRE(threads.code == 0);
+  const auto hybrid = run_shell("OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 mpirun --oversubscribe -n 2 " +
+                                varia() + " ensemble " + kScene + kVaries + "--quiet --threads 2 --out " +
+                                quoted(dir / "hybrid.h5"));
+  CAPTURE(hybrid.err);
+  REQUIRE(hybrid.code == 0);
+  const EnsembleData hybrid_data = read_ensemble(dir / "hybrid.h5");
+  check_same(read_ensemble(dir / "threads.h5"), hybrid_data);
+  for (double status : hybrid_data.datasets.at("status")) CHECK(status == 0);
+}
+
 TEST_CASE("a member that fails is recorded with its exit code and the rest run: exit 0") {
   TempDir dir;
   const auto outcome = run_varia("ensemble scenes/default.json --quiet --vary /step=list:0.1,5,0.2 --out '" +
