@@ -57,8 +57,14 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   int dim() const override { return n_; }
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
+  // The step, then its tangent map by the implicit function theorem on the step's equations
+  // (galerkin_chart_tangent.cpp), the directions and images in the natural charts at g0 and g1.
+  void take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
+                         const double* directions, double* images) override;
 
  public:
+  // Empty: every form has its tangent map.
+  std::string tangent_map_refusal() const override;
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   const EvaluationCounters& evaluations() const override { return lagrangian_.counters(); }
   // Residual norms of the last Newton solve, one per iteration (to show quadratic convergence).
@@ -156,6 +162,11 @@ class LieGroupGalerkinDiscreteLagrangian : public DiscreteLagrangian, public Dis
   Eigen::VectorXd refined_residual_, refined_update_;  // simplified Newton's last update (Equations::finish)
   Eigen::MatrixXd jacobian_;
   int unknowns_ = 0;  // the leading control points solved for: s (step) or s - 1 (evaluate)
+  // The tangent map's workspace: dexp_{xi^s}^{-T}, the right sides and solutions in the control
+  // points, the chart's derivatives at g1 and the end's changes.
+  Eigen::MatrixXd forward_inverse_T_, tangent_rhs_, tangent_xi_, end_point_, chart_inverse_, sigma_change_;
+  Eigen::VectorXd end_momentum_, local_value_;
+  std::vector<double> local_gradient_;
 };
 
 }  // namespace varia
