@@ -175,14 +175,28 @@ TEST_CASE("the one-step construction's tangent map: jets through the method, sym
   }
 }
 
+namespace {
+
+// The heavy top on SO(3) and a start R0 = exp(0.3, -0.5, 0.8), Pi0 = (0.5, -0.45, 1.6): the Lie
+// group constructions' tangent maps are checked there.
+struct HeavyTopStart {
+  Rotations group;
+  Top top{Eigen::Vector3d(1.0, 1.5, 0.8), 1.0, Eigen::Vector3d(0.1, 0.2, 0.5)};
+  Eigen::VectorXd R0 = Eigen::VectorXd(9), p0 = (Eigen::VectorXd(3) << 0.5, -0.45, 1.6).finished();
+  HeavyTopStart() {
+    const Eigen::Vector3d axis(0.3, -0.5, 0.8);
+    REQUIRE(group.retract(vector_of({1, 0, 0, 0, 1, 0, 0, 0, 1}).data(), axis.data(), R0.data()) == nullptr);
+  }
+};
+
+}  // namespace
+
 TEST_CASE("the one-step construction's tangent map on a Lie group: the heavy top on SO(3) in the natural charts at "
           "R0 and R1, by the explicit midpoint rule in the embedding and by the Crouch-Grossman method on the group") {
-  Rotations group;
-  Top top(Eigen::Vector3d(1.0, 1.5, 0.8), 1.0, Eigen::Vector3d(0.1, 0.2, 0.5));
-  Eigen::VectorXd R0(9), p0(3);
-  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8);
-  REQUIRE(group.retract(vector_of({1, 0, 0, 0, 1, 0, 0, 0, 1}).data(), axis.data(), R0.data()) == nullptr);
-  p0 << 0.5, -0.45, 1.6;
+  HeavyTopStart start;
+  Rotations& group = start.group;
+  Top& top = start.top;
+  const Eigen::VectorXd &R0 = start.R0, &p0 = start.p0;
   auto midpoint = explicit_midpoint();
   const auto crouch = crouch_grossman(2);
   for (OneStepMethod* method : {static_cast<OneStepMethod*>(&midpoint), crouch.get()}) {
@@ -194,12 +208,10 @@ TEST_CASE("the one-step construction's tangent map on a Lie group: the heavy top
 
 TEST_CASE("the Lie group Galerkin construction's tangent map: the heavy top on SO(3) in the natural charts at R0 and R1, "
           "degrees 1, 2 and 3") {
-  Rotations group;
-  Top top(Eigen::Vector3d(1.0, 1.5, 0.8), 1.0, Eigen::Vector3d(0.1, 0.2, 0.5));
-  Eigen::VectorXd R0(9), p0(3);
-  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8);
-  REQUIRE(group.retract(vector_of({1, 0, 0, 0, 1, 0, 0, 0, 1}).data(), axis.data(), R0.data()) == nullptr);
-  p0 << 0.5, -0.45, 1.6;
+  HeavyTopStart start;
+  Rotations& group = start.group;
+  Top& top = start.top;
+  const Eigen::VectorXd &R0 = start.R0, &p0 = start.p0;
   for (int s = 1; s <= 3; ++s) {
     CAPTURE(s);
     FixedRule rule = gauss_legendre(s + 1);
@@ -221,12 +233,10 @@ TEST_CASE("the Lie group Galerkin construction's tangent map: the heavy top on S
 
 TEST_CASE("the lie-verlet construction's tangent map (the LGVI, both solvers): the heavy top on SO(3) in the natural "
           "charts at R0 and R1") {
-  Rotations group;
-  Top top(Eigen::Vector3d(1.0, 1.5, 0.8), 1.0, Eigen::Vector3d(0.1, 0.2, 0.5));
-  Eigen::VectorXd R0(9), p0(3);
-  const Eigen::Vector3d axis = Eigen::Vector3d(0.3, -0.5, 0.8);
-  REQUIRE(group.retract(vector_of({1, 0, 0, 0, 1, 0, 0, 0, 1}).data(), axis.data(), R0.data()) == nullptr);
-  p0 << 0.5, -0.45, 1.6;
+  HeavyTopStart start;
+  Rotations& group = start.group;
+  Top& top = start.top;
+  const Eigen::VectorXd &R0 = start.R0, &p0 = start.p0;
   for (LieVerletSolver solver : {LieVerletSolver::cayley, LieVerletSolver::exp}) {
     LieGroupVelocityVerlet map(group, top, solver, {});
     check_tangent_on(group, map, R0, p0);
