@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <string>
+#include <vector>
 
 #include "varia/core/compensated.hpp"
 #include "varia/core/fixed_size.hpp"
@@ -270,10 +271,38 @@ void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
     d2 = lambda_;
 }
 
+// On a Lie group the tangent map below reads the shot's end through the natural chart at g^n, which
+// a Runge-Kutta method integrating in the embedding leaves (its g^n is off the group by its local
+// error): only a Lie group method's shot has it.
 std::string ShootingDiscreteLagrangian::tangent_map_refusal() const {
-  if (mechanical_ == nullptr) return "the shooting construction's tangent map is derived on vector spaces only yet";
+  if (mechanical_ == nullptr && std::string(method_.equivariance()) != "left")
+    return "the shooting construction's tangent map on a Lie group takes a Lie group method (as crouch-grossman), "
+           "whose shot stays on the group; a Runge-Kutta method integrates in the embedding and leaves it";
   return {};
 }
+
+namespace {
+
+// ad_a^T v for each column a of `directions`: (ad_a^T v)_b = v . [a, e_b], the bracket of the
+// group's algebra read off its natural chart at 0 (the left-trivialized velocity dexp_{-xi} xi_dot
+// = xi_dot - [xi, xi_dot] / 2 + O(xi^2): d2 velocity_c / dxi_a dxi_dot_b = -[e_a, e_b]_c / 2).
+Eigen::MatrixXd coadjoint(Manifold& manifold, const double* g, const Eigen::Ref<const Eigen::MatrixXd>& directions,
+                          const Eigen::Ref<const Eigen::VectorXd>& v) {
+  const int n = static_cast<int>(v.size()), V = 2 * n;
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
+  std::vector<double> gradient(static_cast<std::size_t>(n) * V), hessian(static_cast<std::size_t>(n) * V * V);
+  check(manifold, manifold.chart(g, zero.data(), zero.data(), {}, {nullptr, gradient.data(), hessian.data()}),
+        "manifold chart");
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, directions.cols());
+  for (Eigen::Index j = 0; j < directions.cols(); ++j)
+    for (int b = 0; b < n; ++b)
+      for (int c = 0; c < n; ++c)
+        for (int a = 0; a < n; ++a)
+          out(b, j) += v[c] * directions(a, j) * -2.0 * hessian[(static_cast<std::size_t>(c) * V + a) * V + n + b];
+  return out;
+}
+
+}  // namespace
 
 // With lambda(x) = B_w^{-T} alpha_w and Phi = G + W - <lambda, B> with lambda frozen (shooting.hpp),
 // dlambda/dx = B_w^{-T} Phi_wx, and for a direction (dq0, dp0) = (deta, dp0):
@@ -284,7 +313,12 @@ std::string ShootingDiscreteLagrangian::tangent_map_refusal() const {
 // - the type-2 form, D1 H_d^+(x) = alpha_eta - B_eta^T lambda + B (B = p^n): dD1/dx = Phi_etax -
 //   B_eta^T dlambda/dx + B_x, and the step D1 - p0 = 0, q1 = q0 + eta + lambda, p1 = B gives
 //   dw0 = (dD1/dw0)^{-1} (dp0 - dD1/deta dq0), dq1 = (I + dlambda/deta) dq0 + dlambda/dw0 dw0,
-//   dp1 = B_eta dq0 + B_w dw0.
+//   dp1 = B_eta dq0 + B_w dw0;
+// - on a Lie group (the lagrangian form, B = log(c^{-1} g^n) about c = g^n's value at the solution,
+//   D1 = alpha_eta - B_eta^T lambda): moving g0 to g0 exp(e a), the chart's eta at the new base is
+//   e a + eta' + (e/2) [a, eta'] + ... (Baker-Campbell-Hausdorff), so D1 gains 1/2 ad_a^T D1 =
+//   -1/2 ad_a^T p0; dq1 = B_eta dq0 + B_w dw0 in the chart at g1; and the momentum, left-trivialized
+//   at g^n itself, is dexp_{-B}^{-T} lambda, so dp1 = dlambda + 1/2 ad_{dq1}^T lambda.
 void ShootingDiscreteLagrangian::take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1,
                                                    double* p1, int count, const double* directions, double* images) {
   take_step(q0, p0, t0, h, q1, p1);
@@ -313,19 +347,30 @@ void ShootingDiscreteLagrangian::take_tangent_step(const double* q0, const doubl
   tangent_lambda_ = tangent_bw_lu_.solve(phi_.bottomRows(n));
   tangent_d1_ = phi_.topRows(n);
   tangent_d1_.noalias() -= Bq_.transpose() * tangent_lambda_;
+  const bool group = mechanical_ == nullptr;
   if (type_2()) {
     tangent_d1_.leftCols(n) += Bq_;
     tangent_d1_.rightCols(n) += Bw_;
-  } else {
+  } else if (!group) {
     tangent_d1_ -= tangent_lambda_;
   }
   tangent_lu_.compute(tangent_d1_.rightCols(n));
   tangent_rhs_ = dp0;
   if (!type_2()) tangent_rhs_ = -tangent_rhs_;
   tangent_rhs_.noalias() -= tangent_d1_.leftCols(n) * dq0;
+  const Eigen::Map<const Eigen::VectorXd> momentum(p0, n);
+  if (group) tangent_rhs_ += 0.5 * coadjoint(manifold_, q0, dq0, momentum);
   tangent_w_.noalias() = tangent_lu_.solve(tangent_rhs_);
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dq1(images, n, count, Eigen::OuterStride<>(2 * n));
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dp1(images + n, n, count, Eigen::OuterStride<>(2 * n));
+  if (group) {
+    dq1.noalias() = Bq_ * dq0;
+    dq1.noalias() += Bw_ * tangent_w_;
+    dp1.noalias() = tangent_lambda_.leftCols(n) * dq0;
+    dp1.noalias() += tangent_lambda_.rightCols(n) * tangent_w_;
+    dp1 += 0.5 * coadjoint(manifold_, q1, dq1, Eigen::Map<const Eigen::VectorXd>(lambda_.data(), n));
+    return;
+  }
   // Type I: the position's offset is B and the momentum lambda; type 2 the other way round.
   dq1 = dq0;
   if (type_2()) {

@@ -231,6 +231,24 @@ TEST_CASE("the Lie group Galerkin construction's tangent map: the heavy top on S
   check_tangent_on(group, reduced, R0, p0);
 }
 
+TEST_CASE("shooting's tangent map on a Lie group: the heavy top on SO(3) in the natural charts at R0 and R1, by "
+          "Crouch-Grossman of orders 2 and 3 with the trapezoidal and Simpson's rules, and refused with a Runge-Kutta "
+          "method in the embedding") {
+  HeavyTopStart start;
+  auto trapezoid_rule = trapezoid();
+  auto simpson_rule = simpson();
+  const auto second = crouch_grossman(2), third = crouch_grossman(3);
+  ShootingDiscreteLagrangian cg2(start.group, start.top, trapezoid_rule, *second, ShootingForm::lagrangian, {});
+  ShootingDiscreteLagrangian cg3(start.group, start.top, simpson_rule, *third, ShootingForm::lagrangian, {});
+  for (ShootingDiscreteLagrangian* map : {&cg2, &cg3}) {
+    REQUIRE(map->tangent_map_refusal().empty());
+    check_tangent_on(start.group, *map, start.R0, start.p0);
+  }
+  auto midpoint = explicit_midpoint();
+  ShootingDiscreteLagrangian embedded(start.group, start.top, simpson_rule, midpoint, ShootingForm::lagrangian, {});
+  CHECK(embedded.tangent_map_refusal().find("Lie group method") != std::string::npos);
+}
+
 TEST_CASE("the lie-verlet construction's tangent map (the LGVI, both solvers): the heavy top on SO(3) in the natural "
           "charts at R0 and R1") {
   HeavyTopStart start;
@@ -285,13 +303,34 @@ TEST_CASE("shooting's tangent map: the lagrangian form (SVIRK4, its explicit sho
 }
 
 TEST_CASE("constructions without a tangent map say why, and step_with_tangent refuses them") {
-  auto rule = simpson();
+  // The one-step construction with a constraint (q^2 - 1)/2 = 0 on R^1: each step is projected.
+  struct UnitPoint final : Constraint {
+    Status bind(int, int) noexcept override { return nullptr; }
+    int size() const noexcept override { return 1; }
+    int jacobian_pattern(const int** rows, const int** cols) const noexcept override {
+      static constexpr int zero[1] = {0};
+      *rows = zero;
+      *cols = zero;
+      return 1;
+    }
+    int hessian_pattern(const int** rows, const int** cols) const noexcept override { return jacobian_pattern(rows, cols); }
+    Status evaluate(const double* q, double* g, double* G) noexcept override {
+      if (g != nullptr) g[0] = 0.5 * (q[0] * q[0] - 1.0);
+      if (G != nullptr) G[0] = q[0];
+      return nullptr;
+    }
+    Status weighted_hessian(const double*, const double* lambda, double* values) noexcept override {
+      values[0] = lambda[0];
+      return nullptr;
+    }
+  } point;
+  FlatSpace line(1);
+  MassOscillator oscillator;
+  HolonomicConstraints constraints({&point}, 1);
   auto method = rk4();
-  Rotations group;
-  Top body(Eigen::Vector3d(1, 2, 3), 0.0, Eigen::Vector3d::Zero());
-  ShootingDiscreteLagrangian on_rotations(group, body, rule, method, ShootingForm::lagrangian, {});
-  CHECK(on_rotations.tangent_map_refusal().find("vector spaces") != std::string::npos);
-  double R1[9], p1[3], image[6];
-  const double R0[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, p0[3] = {0.1, 0.2, 0.3}, direction[6] = {1, 0, 0, 0, 0, 0};
-  CHECK_THROWS_AS(on_rotations.step_with_tangent(R0, p0, 0.0, 0.1, R1, p1, 1, direction, image), std::logic_error);
+  OneStepHamiltonianMap projected(line, oscillator, method, {}, &constraints);
+  CHECK(projected.tangent_map_refusal().find("projects") != std::string::npos);
+  double q1[1], p1[1], image[2];
+  const double q0[1] = {1.0}, p0[1] = {0.0}, direction[2] = {1, 0};
+  CHECK_THROWS_AS(projected.step_with_tangent(q0, p0, 0.0, 0.1, q1, p1, 1, direction, image), std::logic_error);
 }
