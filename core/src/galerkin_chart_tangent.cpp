@@ -7,14 +7,14 @@
 // g0 exp(e a) exp(xi(t)), the chart's eta = e a exactly, so dR_nu and d sigma take the action's
 // Hessian block in eta, H_{., eta} a. The momentum equation's tau is the derivative along
 // g0 exp(e a) exp(d e_b) = g0 exp(e a + d e_b + (e d / 2) [a, e_b] + ...) (Baker-Campbell-Hausdorff),
-// so d tau = H_{eta eta} a + 1/2 ad_a^T tau, the bracket read off dexp's slopes at 0
-// (dexp_w = I + ad_w / 2 + O(w^2)). With J the step's Newton Jacobian in xi^1..xi^s:
+// so d tau = H_{eta eta} a + 1/2 ad_a^T tau (coadjoint, lie_group_field.hpp). With J the step's Newton Jacobian in xi^1..xi^s:
 //   J dxi = -(dR/da a + (b; 0)),
 //   dg1 = C1 (P_eta a + P_xi dxi^s)   (P: the chart's point gradient at xi^s; C1 = d local(g1, g)/dg),
 //   dp1 = A^{-T} (d sigma - sum_l dxi^s_l (dA/dxi_l)^T p1),   A = dexp_{-xi^s}.
 // The reduced form is the same with tau = 0 and no position derivatives, which vanish exactly for
 // a Lagrangian invariant under the whole group.
 #include "varia/core/galerkin_chart.hpp"
+#include "varia/core/lie_group_field.hpp"
 
 namespace varia {
 
@@ -44,7 +44,7 @@ void LieGroupGalerkinDiscreteLagrangian::take_tangent_step(const double* q0, con
   momentum_row.noalias() = hessian_.block(0, 0, n, n) * a;
   momentum_row.noalias() -= forward_inverse_T_ * (hessian_.block(s * n, 0, n, n) * a);
   momentum_row += b;
-  for (int l = 0; l < n; ++l) momentum_row.noalias() += (dexp_slopes_[l].transpose() * tau) * a.row(l);
+  momentum_row += 0.5 * coadjoint(structure_constants(manifold_, q0), a, tau);
   lu_.compute(jacobian_.topLeftCorner(U, U));
   tangent_xi_.noalias() = -lu_.solve(tangent_rhs_);
   const auto dxi = tangent_xi_.bottomRows(n);

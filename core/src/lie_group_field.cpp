@@ -28,7 +28,6 @@ LieGroupField::LieGroupField(Manifold& manifold, LagrangianEvaluator& lagrangian
       m_(manifold.point_size()),
       generators_(m_ * n_),
       gradient_(m_ + n_),
-      chart_hessian_(4 * n_ * n_ * n_),
       point_jet_(m_),
       generators_jet_(m_ * n_),
       gradient_jet_(m_ + n_),
@@ -58,19 +57,34 @@ int LieGroupField::jet_variables() const {
   return constant_mass_ ? kMaxJetVariables : std::min(kMaxJetVariables, hessian_jet_variables_);
 }
 
-// dexp_{-xi} v = v - 1/2 [xi, v] + O(|xi|^2 |v|): the chart velocity's mixed second derivative
-// in (xi_a, v_b) at 0 is -1/2 [e_a, e_b].
-void LieGroupField::learn_structure(const double* point) {
-  if (!structure_.empty()) return;
-  const std::vector<double> zero(n_, 0.0);
-  check(manifold_, manifold_.chart(point, zero.data(), zero.data(), {}, {nullptr, nullptr, chart_hessian_.data()}),
+std::vector<double> structure_constants(Manifold& manifold, const double* point) {
+  const int n = manifold.dim(), V = 2 * n;
+  const std::vector<double> zero(n, 0.0);
+  std::vector<double> hessian(static_cast<std::size_t>(n) * V * V), structure(static_cast<std::size_t>(n) * n * n);
+  check(manifold, manifold.chart(point, zero.data(), zero.data(), {}, {nullptr, nullptr, hessian.data()}),
         "manifold chart");
-  const int V = 2 * n_;
-  structure_.resize(n_ * n_ * n_);
-  for (int c = 0; c < n_; ++c)
-    for (int a = 0; a < n_; ++a)
-      for (int b = 0; b < n_; ++b)
-        structure_[(c * n_ + a) * n_ + b] = -2.0 * chart_hessian_[(c * V + a) * V + n_ + b];
+  for (int c = 0; c < n; ++c)
+    for (int a = 0; a < n; ++a)
+      for (int b = 0; b < n; ++b)
+        structure[(static_cast<std::size_t>(c) * n + a) * n + b] =
+            -2.0 * hessian[(static_cast<std::size_t>(c) * V + a) * V + n + b];
+  return structure;
+}
+
+Eigen::MatrixXd coadjoint(const std::vector<double>& structure, const Eigen::Ref<const Eigen::MatrixXd>& directions,
+                          const Eigen::Ref<const Eigen::VectorXd>& v) {
+  const auto n = v.size();
+  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, directions.cols());
+  for (Eigen::Index j = 0; j < directions.cols(); ++j)
+    for (Eigen::Index b = 0; b < n; ++b)
+      for (Eigen::Index c = 0; c < n; ++c)
+        for (Eigen::Index a = 0; a < n; ++a)
+          out(b, j) += v[c] * directions(a, j) * structure[static_cast<std::size_t>((c * n + a) * n + b)];
+  return out;
+}
+
+void LieGroupField::learn_structure(const double* point) {
+  if (structure_.empty()) structure_ = structure_constants(manifold_, point);
 }
 
 void LieGroupField::prepare(const double* y) {

@@ -11,6 +11,7 @@
 
 #include "varia/core/compensated.hpp"
 #include "varia/core/fixed_size.hpp"
+#include "varia/core/lie_group_field.hpp"
 
 namespace varia {
 
@@ -281,28 +282,6 @@ std::string ShootingDiscreteLagrangian::tangent_map_refusal() const {
   return {};
 }
 
-namespace {
-
-// ad_a^T v for each column a of `directions`: (ad_a^T v)_b = v . [a, e_b], the bracket of the
-// group's algebra read off its natural chart at 0 (the left-trivialized velocity dexp_{-xi} xi_dot
-// = xi_dot - [xi, xi_dot] / 2 + O(xi^2): d2 velocity_c / dxi_a dxi_dot_b = -[e_a, e_b]_c / 2).
-Eigen::MatrixXd coadjoint(Manifold& manifold, const double* g, const Eigen::Ref<const Eigen::MatrixXd>& directions,
-                          const Eigen::Ref<const Eigen::VectorXd>& v) {
-  const int n = static_cast<int>(v.size()), V = 2 * n;
-  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(n);
-  std::vector<double> gradient(static_cast<std::size_t>(n) * V), hessian(static_cast<std::size_t>(n) * V * V);
-  check(manifold, manifold.chart(g, zero.data(), zero.data(), {}, {nullptr, gradient.data(), hessian.data()}),
-        "manifold chart");
-  Eigen::MatrixXd out = Eigen::MatrixXd::Zero(n, directions.cols());
-  for (Eigen::Index j = 0; j < directions.cols(); ++j)
-    for (int b = 0; b < n; ++b)
-      for (int c = 0; c < n; ++c)
-        for (int a = 0; a < n; ++a)
-          out(b, j) += v[c] * directions(a, j) * -2.0 * hessian[(static_cast<std::size_t>(c) * V + a) * V + n + b];
-  return out;
-}
-
-}  // namespace
 
 // With lambda(x) = B_w^{-T} alpha_w and Phi = G + W - <lambda, B> with lambda frozen (shooting.hpp),
 // dlambda/dx = B_w^{-T} Phi_wx, and for a direction (dq0, dp0) = (deta, dp0):
@@ -359,7 +338,8 @@ void ShootingDiscreteLagrangian::take_tangent_step(const double* q0, const doubl
   if (!type_2()) tangent_rhs_ = -tangent_rhs_;
   tangent_rhs_.noalias() -= tangent_d1_.leftCols(n) * dq0;
   const Eigen::Map<const Eigen::VectorXd> momentum(p0, n);
-  if (group) tangent_rhs_ += 0.5 * coadjoint(manifold_, q0, dq0, momentum);
+  const std::vector<double> structure = group ? structure_constants(manifold_, q0) : std::vector<double>{};
+  if (group) tangent_rhs_ += 0.5 * coadjoint(structure, dq0, momentum);
   tangent_w_.noalias() = tangent_lu_.solve(tangent_rhs_);
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dq1(images, n, count, Eigen::OuterStride<>(2 * n));
   Eigen::Map<Eigen::MatrixXd, 0, Eigen::OuterStride<>> dp1(images + n, n, count, Eigen::OuterStride<>(2 * n));
@@ -368,7 +348,7 @@ void ShootingDiscreteLagrangian::take_tangent_step(const double* q0, const doubl
     dq1.noalias() += Bw_ * tangent_w_;
     dp1.noalias() = tangent_lambda_.leftCols(n) * dq0;
     dp1.noalias() += tangent_lambda_.rightCols(n) * tangent_w_;
-    dp1 += 0.5 * coadjoint(manifold_, q1, dq1, Eigen::Map<const Eigen::VectorXd>(lambda_.data(), n));
+    dp1 += 0.5 * coadjoint(structure, dq1, Eigen::Map<const Eigen::VectorXd>(lambda_.data(), n));
     return;
   }
   // Type I: the position's offset is B and the momentum lambda; type 2 the other way round.

@@ -27,6 +27,17 @@
 
 namespace varia {
 
+// The structure constants [e_a, e_b]_c of a Lie group's algebra, at [(c n + a) n + b], read off its
+// natural chart at `point`: dexp_{-xi} v = v - [xi, v] / 2 + O(|xi|^2 |v|), so the chart velocity's
+// mixed second derivative in (xi_a, v_b) at 0 is -[e_a, e_b] / 2 (the velocity part of the chart
+// does not depend on the point).
+std::vector<double> structure_constants(Manifold& manifold, const double* point);
+// ad_a^T v for each column a of `directions`: (ad_a^T v)_b = v . [a, e_b], from the structure
+// constants (the tangent maps' Baker-Campbell-Hausdorff terms: galerkin_chart_tangent.cpp,
+// shooting_solve.cpp).
+Eigen::MatrixXd coadjoint(const std::vector<double>& structure, const Eigen::Ref<const Eigen::MatrixXd>& directions,
+                          const Eigen::Ref<const Eigen::VectorXd>& v);
+
 class LieGroupField final : public EulerLagrangeField {
  public:
   // Throws std::invalid_argument unless the manifold is a Lie group (not a vector space) whose
@@ -68,7 +79,7 @@ class LieGroupField final : public EulerLagrangeField {
   int m_;
   std::vector<double> structure_;
   // Workspace, sized once.
-  std::vector<double> generators_, gradient_, chart_hessian_;
+  std::vector<double> generators_, gradient_;
   std::vector<Jet2> point_jet_, generators_jet_, gradient_jet_, momentum_jet_, torque_jet_, y_jet_,
       f_jet_;
   Eigen::VectorXd momentum_, torque_, group_velocity_;
