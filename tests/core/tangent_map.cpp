@@ -194,30 +194,24 @@ struct HeavyTopStart {
 TEST_CASE("the one-step construction's tangent map on a Lie group: the heavy top on SO(3) in the natural charts at "
           "R0 and R1, by the explicit midpoint rule in the embedding and by the Crouch-Grossman method on the group") {
   HeavyTopStart start;
-  Rotations& group = start.group;
-  Top& top = start.top;
-  const Eigen::VectorXd &R0 = start.R0, &p0 = start.p0;
   auto midpoint = explicit_midpoint();
   const auto crouch = crouch_grossman(2);
   for (OneStepMethod* method : {static_cast<OneStepMethod*>(&midpoint), crouch.get()}) {
-    OneStepHamiltonianMap map(group, top, *method, {});
+    OneStepHamiltonianMap map(start.group, start.top, *method, {});
     REQUIRE(map.tangent_map_refusal().empty());
-    check_tangent_on(group, map, R0, p0);
+    check_tangent_on(start.group, map, start.R0, start.p0);
   }
 }
 
 TEST_CASE("the Lie group Galerkin construction's tangent map: the heavy top on SO(3) in the natural charts at R0 and R1, "
           "degrees 1, 2 and 3") {
   HeavyTopStart start;
-  Rotations& group = start.group;
-  Top& top = start.top;
-  const Eigen::VectorXd &R0 = start.R0, &p0 = start.p0;
   for (int s = 1; s <= 3; ++s) {
     CAPTURE(s);
     FixedRule rule = gauss_legendre(s + 1);
-    LieGroupGalerkinDiscreteLagrangian map(group, top, rule, equispaced_control_times(s), {});
+    LieGroupGalerkinDiscreteLagrangian map(start.group, start.top, rule, equispaced_control_times(s), {});
     REQUIRE(map.tangent_map_refusal().empty());
-    check_tangent_on(group, map, R0, p0);
+    check_tangent_on(start.group, map, start.R0, start.p0);
   }
   // The free body, invariant under the whole group: the reduced form (tau = 0 and no position
   // derivatives, exactly), its inertia declared constant.
@@ -227,8 +221,8 @@ TEST_CASE("the Lie group Galerkin construction's tangent map: the heavy top on S
     int momentum_size() const noexcept override { return 3; }
   } free_body(Eigen::Vector3d(1.0, 1.5, 0.8), 0.0, Eigen::Vector3d::Zero());
   FixedRule rule = gauss_legendre(3);
-  LieGroupGalerkinDiscreteLagrangian reduced(group, free_body, rule, equispaced_control_times(2), {}, true);
-  check_tangent_on(group, reduced, R0, p0);
+  LieGroupGalerkinDiscreteLagrangian reduced(start.group, free_body, rule, equispaced_control_times(2), {}, true);
+  check_tangent_on(start.group, reduced, start.R0, start.p0);
 }
 
 TEST_CASE("shooting's tangent map on a Lie group: the heavy top on SO(3) in the natural charts at R0 and R1, by "
@@ -252,12 +246,9 @@ TEST_CASE("shooting's tangent map on a Lie group: the heavy top on SO(3) in the 
 TEST_CASE("the lie-verlet construction's tangent map (the LGVI, both solvers): the heavy top on SO(3) in the natural "
           "charts at R0 and R1") {
   HeavyTopStart start;
-  Rotations& group = start.group;
-  Top& top = start.top;
-  const Eigen::VectorXd &R0 = start.R0, &p0 = start.p0;
   for (LieVerletSolver solver : {LieVerletSolver::cayley, LieVerletSolver::exp}) {
-    LieGroupVelocityVerlet map(group, top, solver, {});
-    check_tangent_on(group, map, R0, p0);
+    LieGroupVelocityVerlet map(start.group, start.top, solver, {});
+    check_tangent_on(start.group, map, start.R0, start.p0);
   }
 }
 

@@ -191,6 +191,18 @@ namespace {
 
 json scene_file(const char* name) { return json::parse(test::read_file(test::kSourceDir / "scenes/multibody" / name)); }
 
+// The run record of `document`, run as `varia run` runs it (quiet, nothing written).
+json record_of(const json& document, Registry& registry) {
+  Scene scene;
+  Assembly a = assembled(document, registry, scene);
+  RunOptions options;
+  options.quiet = true;
+  json record;
+  options.record = &record;
+  run_scene(scene, a, registry, options);
+  return record;
+}
+
 // pendulum-chain's positions x_i = l_1 q_1 + ... + l_i q_i, from the rods' directions q_i.
 Eigen::VectorXd chain_positions(const Eigen::VectorXd& q, const std::vector<double>& lengths) {
   Eigen::VectorXd x(q.size());
@@ -244,12 +256,8 @@ TEST_CASE("pendulum-chain on S2 x S2 keeps its vertical angular momentum to 1e-1
   document.erase("t_end");
   document["steps"] = 100000;
   document["observe"] = {"momentum", "constraint"};
-  RunOptions options;
-  options.quiet = true;
-  json record;
-  options.record = &record;
-  Assembly a = assembled(document, registry, scene);
-  run_scene(scene, a, registry, options);
+  const json record = record_of(document, registry);
+  const Assembly a = assembled(document, registry, scene);
   double J0 = 0.0;
   a.lagrangian->momentum(a.q0.data(), a.v0.data(), &J0);
   const double relative = record["momentum_error_max"].get<double>() / std::abs(J0);
@@ -265,12 +273,7 @@ TEST_CASE("on S2 x S2 a momentum is read and written orthogonal to the normals, 
   Scene scene;
   json document = scene_file("double-spherical-pendulum-s2.json");
   document["t_end"] = 0.5;
-  RunOptions options;
-  options.quiet = true;
-  json record;
-  options.record = &record;
-  Assembly a = assembled(document, registry, scene);
-  run_scene(scene, a, registry, options);
+  const json record = record_of(document, registry);
   const auto q = record["final"]["q"].get<std::vector<double>>(), p = record["final"]["p"].get<std::vector<double>>();
   for (int i = 0; i < 2; ++i) {
     const double along = q[3 * i] * p[3 * i] + q[3 * i + 1] * p[3 * i + 1] + q[3 * i + 2] * p[3 * i + 2];
@@ -279,18 +282,10 @@ TEST_CASE("on S2 x S2 a momentum is read and written orthogonal to the normals, 
   json restart = scene_file("double-spherical-pendulum-s2.json");
   restart["initial"] = {{"q", q}, {"p", p}};
   restart["t_end"] = 0.5;
-  Scene again;
-  json record_again;
-  options.record = &record_again;
-  Assembly b = assembled(restart, registry, again);
-  run_scene(again, b, registry, options);
+  const json record_again = record_of(restart, registry);
   json onward = scene_file("double-spherical-pendulum-s2.json");
   onward["t_end"] = 1.0;
-  Scene whole;
-  json record_whole;
-  options.record = &record_whole;
-  Assembly c = assembled(onward, registry, whole);
-  run_scene(whole, c, registry, options);
+  const json record_whole = record_of(onward, registry);
   const auto q1 = record_again["final"]["q"].get<std::vector<double>>(), q2 = record_whole["final"]["q"].get<std::vector<double>>();
   for (int k = 0; k < 6; ++k) CHECK(std::abs(q1[k] - q2[k]) <= 1e-12);
   json across = scene_file("double-spherical-pendulum-s2.json");
