@@ -1,73 +1,226 @@
 #include "varia/core/constrained_field.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <type_traits>
 
 namespace varia {
+
+namespace {
+
+// r = 0 (a constant jet at jets).
+template <class T>
+void set_zero(T& r) {
+  r = T(0.0);
+}
+
+}  // namespace
 
 ConstrainedField::ConstrainedField(LagrangianEvaluator& lagrangian, HolonomicConstraints& constraints)
     : EulerLagrangeField(lagrangian),
       constraints_(constraints),
       m_(constraints.size()),
-      W_(n_, m_),
-      S_(m_, m_),
-      S_factor_(m_),
-      gradient_(2 * n_),
-      lambda_(m_),
-      rhs_(m_),
+      quadratic_(constraints.quadratic()),
+      point_(n_),
+      values_(m_),
       unit_(Eigen::VectorXd::Zero(m_)),
-      g_(m_),
-      curvature_(n_) {
+      lu_(m_),
+      jet_solve_(m_) {
   if (!constant_mass_)
     throw std::invalid_argument("constraints need a Lagrangian with a constant mass matrix");
+  const auto size = [&](auto& w) {
+    for (auto* v : {&w.g, &w.curvature, &w.rhs, &w.multiplier, &w.step}) v->resize(m_);
+    for (auto* v : {&w.gradient}) v->resize(2 * n_);
+    for (auto* v : {&w.free, &w.offset, &w.start}) v->resize(n_);
+    for (auto* M : {&w.GT, &w.W, &w.W_start}) M->resize(n_, m_);
+    w.S.resize(m_, m_);
+  };
+  size(doubles_);
+  size(jets_);
 }
 
-void ConstrainedField::factor(const double* q) {
-  constraints_.evaluate_jacobian(q, g_.data());
-  W_.noalias() = inverse_mass_ * constraints_.jacobian().transpose();
-  S_.noalias() = constraints_.jacobian() * W_;
-  S_factor_.compute(S_);
-  if (S_factor_.info() != Eigen::Success)
-    throw NumericalFailure("G M^-1 G^T is singular: the constraints' Jacobian has lost its rank", std::nan(""));
+template <>
+ConstrainedField::Workspace<double>& ConstrainedField::workspace<double>() {
+  return doubles_;
+}
+template <>
+ConstrainedField::Workspace<Jet2>& ConstrainedField::workspace<Jet2>() {
+  return jets_;
+}
+
+void ConstrainedField::require_quadratic() const {
+  if (!quadratic_)
+    throw std::invalid_argument("the constrained field at jets takes quadratic constraints only (Constraint::quadratic: "
+                                "a constant Hessian); others would need g's third and fourth derivatives");
+}
+
+// At doubles g, G and H_i come from the constraints at q. At a jet q = p + d (p its value) they are
+// g_i(p) + G_i(p) d + d^T H_i d / 2, G_i(p) + H_i d and H_i, exact for quadratic constraints.
+template <class T>
+void ConstrainedField::linearize(const T* q, const T* v, Workspace<T>& w) {
+  constexpr bool jets = std::is_same_v<T, Jet2>;
+  for (int k = 0; k < n_; ++k) point_[k] = value_of(q[k]);
+  if constexpr (jets) {
+    constraints_.evaluate_jacobian(point_.data(), values_.data());
+    for (int i = 0; i < m_; ++i) w.g[i] = values_[i];
+  } else {
+    constraints_.evaluate_jacobian(point_.data(), w.g.data());
+  }
+  for (Eigen::Index i = 0; i < w.GT.size(); ++i) set_zero(w.GT.data()[i]);
+  const auto& G = constraints_.jacobian();
+  for (int i = 0; i < m_; ++i)
+    for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(G, i); it; ++it) w.GT(it.col(), i) = it.value();
+  if (!jets && v == nullptr) return;
+  if constexpr (jets) {
+    for (int k = 0; k < n_; ++k) {
+      w.offset[k] = q[k];
+      w.offset[k].value = 0.0;
+    }
+    for (int i = 0; i < m_; ++i)
+      for (Eigen::SparseMatrix<double, Eigen::RowMajor>::InnerIterator it(G, i); it; ++it)
+        add_scaled(w.g[i], it.value(), w.offset[it.col()]);
+  }
+  for (int i = 0; i < m_; ++i) {
+    unit_[i] = 1.0;
+    constraints_.evaluate_hessian(point_.data(), unit_.data());
+    unit_[i] = 0.0;
+    const auto& H = constraints_.hessian();
+    if (v != nullptr) set_zero(w.curvature[i]);
+    for (int k = 0; k < n_; ++k)
+      for (Eigen::SparseMatrix<double>::InnerIterator it(H, k); it; ++it) {
+        const int j = static_cast<int>(it.row());
+        if (v != nullptr) w.curvature[i] += it.value() * v[j] * v[k];
+        if constexpr (jets) {
+          add_scaled(w.GT(j, i), it.value(), w.offset[k]);
+          w.g[i] += (0.5 * it.value()) * w.offset[j] * w.offset[k];
+        }
+      }
+  }
+}
+
+template <class T>
+void ConstrainedField::factor(Workspace<T>& w) {
+  for (int i = 0; i < m_; ++i)
+    for (int j = 0; j < n_; ++j) {
+      T& x = w.W(j, i);
+      set_zero(x);
+      for (int k = 0; k < n_; ++k)
+        if (inverse_mass_(j, k) != 0.0) add_scaled(x, inverse_mass_(j, k), w.GT(k, i));
+    }
+  for (int i = 0; i < m_; ++i)
+    for (int l = 0; l < m_; ++l) {
+      T& s = w.S(i, l);
+      set_zero(s);
+      for (int j = 0; j < n_; ++j) s += w.GT(j, i) * w.W(j, l);
+    }
+}
+
+template <class T>
+void ConstrainedField::solve(const typename Workspace<T>::Matrix& A, const typename Workspace<T>::Vector& b,
+                             typename Workspace<T>::Vector& x) {
+  if constexpr (std::is_same_v<T, Jet2>) {
+    jet_solve_.solve(A.data(), m_, b.data(), x.data());
+  } else {
+    lu_.compute(A);
+    x = lu_.solve(b);
+    if (!x.allFinite())
+      throw NumericalFailure("G M^-1 G^T is singular: the constraints' Jacobian has lost its rank", std::nan(""));
+  }
 }
 
 // f = (v, a), a = M^-1 L_q - W lambda with S lambda = G M^-1 L_q + c.
-Status ConstrainedField::eval(const double* y, double* f) noexcept {
+template <class T>
+Status ConstrainedField::evaluate(const T* y, T* f) noexcept {
   return guard([&] {
-    const Eigen::Map<const Eigen::VectorXd> v(y + n_, n_);
-    Eigen::Map<Eigen::VectorXd>(f, n_) = v;
-    Eigen::Map<Eigen::VectorXd> a(f + n_, n_);
-    lagrangian_.gradient(y, y + n_, gradient_.data());
-    a.noalias() = inverse_mass_ * gradient_.head(n_);
-    factor(y);
-    rhs_.noalias() = constraints_.jacobian() * a;
+    Workspace<T>& w = workspace<T>();
+    const T* v = y + n_;
+    std::copy_n(v, n_, f);
+    if constexpr (std::is_same_v<T, Jet2>) lagrangian_.gradient_jet(y, v, nullptr, w.gradient.data());
+    else lagrangian_.gradient(y, v, w.gradient.data());
+    inverse_mass(w.gradient.data(), w.free.data());
+    linearize(y, v, w);
+    factor(w);
     for (int i = 0; i < m_; ++i) {
-      unit_[i] = 1.0;
-      constraints_.evaluate_hessian(y, unit_.data());
-      curvature_.noalias() = constraints_.hessian() * v;
-      rhs_[i] += v.dot(curvature_);
-      unit_[i] = 0.0;
+      w.rhs[i] = w.curvature[i];
+      for (int j = 0; j < n_; ++j) w.rhs[i] += w.GT(j, i) * w.free[j];
     }
-    lambda_ = S_factor_.solve(rhs_);
-    a.noalias() -= W_ * lambda_;
+    solve<T>(w.S, w.rhs, w.multiplier);
+    T* a = f + n_;
+    for (int j = 0; j < n_; ++j) {
+      a[j] = w.free[j];
+      for (int i = 0; i < m_; ++i) a[j] -= w.W(j, i) * w.multiplier[i];
+    }
   });
 }
 
-void ConstrainedField::project(double* q, double* v, const SolverOptions& options) {
-  Eigen::Map<Eigen::VectorXd> position(q, n_), velocity(v, n_);
-  double residual = INFINITY;
-  for (int k = 0; k <= options.max_iterations; ++k) {
-    factor(q);
-    residual = g_.lpNorm<Eigen::Infinity>();
-    if (residual <= options.tolerance) break;
-    if (k == options.max_iterations)
+Status ConstrainedField::eval(const double* y, double* f) noexcept { return evaluate(y, f); }
+
+Status ConstrainedField::eval(const Jet2* y, Jet2* f) noexcept {
+  if (!quadratic_) return "the constrained field at jets takes quadratic constraints only (Constraint::quadratic)";
+  return evaluate(y, f);
+}
+
+// q = q^ - W(q^) mu with g(q) = 0 by Newton's method in mu (Jacobian G(q) W(q^)); at jets two
+// iterations past the values' convergence.
+template <class T>
+void ConstrainedField::project_point(T* q, const SolverOptions& options) {
+  Workspace<T>& w = workspace<T>();
+  linearize(q, static_cast<const T*>(nullptr), w);
+  factor(w);
+  w.W_start = w.W;
+  for (int k = 0; k < n_; ++k) w.start[k] = q[k];
+  for (int i = 0; i < m_; ++i) set_zero(w.multiplier[i]);
+  int exact = std::is_same_v<T, Jet2> ? 2 : 0;  // iterations still to run after the values converged
+  for (int iteration = 0;; ++iteration) {
+    double residual = 0.0;
+    for (int i = 0; i < m_; ++i) residual = std::max(residual, std::abs(value_of(w.g[i])));
+    if (residual <= options.tolerance && exact-- == 0) return;
+    if (iteration == options.max_iterations)
       throw NumericalFailure("the projection onto the constraint did not converge", residual);
-    lambda_ = S_factor_.solve(g_);
-    position.noalias() -= W_ * lambda_;
+    for (int i = 0; i < m_; ++i)
+      for (int l = 0; l < m_; ++l) {
+        T& s = w.S(i, l);
+        set_zero(s);
+        for (int j = 0; j < n_; ++j) s += w.GT(j, i) * w.W_start(j, l);
+      }
+    solve<T>(w.S, w.g, w.step);
+    w.multiplier += w.step;
+    for (int j = 0; j < n_; ++j) {
+      q[j] = w.start[j];
+      for (int i = 0; i < m_; ++i) q[j] -= w.W_start(j, i) * w.multiplier[i];
+    }
+    linearize(q, static_cast<const T*>(nullptr), w);
   }
-  rhs_.noalias() = constraints_.jacobian() * velocity;
-  lambda_ = S_factor_.solve(rhs_);
-  velocity.noalias() -= W_ * lambda_;
+}
+
+// v - W S^-1 G v, with the workspace's G^T at q.
+template <class T>
+void ConstrainedField::project_onto_hidden(T* v, Workspace<T>& w) {
+  factor(w);
+  for (int i = 0; i < m_; ++i) {
+    set_zero(w.rhs[i]);
+    for (int j = 0; j < n_; ++j) w.rhs[i] += w.GT(j, i) * v[j];
+  }
+  solve<T>(w.S, w.rhs, w.multiplier);
+  for (int j = 0; j < n_; ++j)
+    for (int i = 0; i < m_; ++i) v[j] -= w.W(j, i) * w.multiplier[i];
+}
+
+void ConstrainedField::project(double* q, double* v, const SolverOptions& options) {
+  project_point(q, options);
+  project_onto_hidden(v, doubles_);
+}
+
+void ConstrainedField::project(Jet2* q, Jet2* v, const SolverOptions& options) {
+  require_quadratic();
+  project_point(q, options);
+  project_onto_hidden(v, jets_);
+}
+
+void ConstrainedField::project_velocity(const double* q, double* v) {
+  linearize(q, static_cast<const double*>(nullptr), doubles_);
+  project_onto_hidden(v, doubles_);
 }
 
 }  // namespace varia

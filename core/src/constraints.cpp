@@ -62,6 +62,10 @@ HolonomicConstraints::HolonomicConstraints(std::vector<Constraint*> constraints,
   g_.resize(m_);
 }
 
+bool HolonomicConstraints::quadratic() const {
+  return std::all_of(parts_.begin(), parts_.end(), [](const Part& part) { return part.constraint->quadratic(); });
+}
+
 void HolonomicConstraints::values(const double* q, double* g) {
   for (Part& part : parts_) {
     check(*part.constraint, part.constraint->evaluate(q, g + part.first_row, nullptr), "constraint evaluate");

@@ -29,9 +29,24 @@ Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingFo
 }
 
 // The Euler-Lagrange field of the manifold's phase space: on R^n in (q, v) or (q, p), with the
-// forces; on a Lie group in (g, xi) (the Euler-Poincare field, lie_group_field.hpp).
+// forces; with constraints the constrained field in (q, v) (constrained_field.hpp); on a Lie group
+// in (g, xi) (the Euler-Poincare field, lie_group_field.hpp).
 std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvaluator& lagrangian,
-                                            ShootingForm form, Forces& forces) {
+                                            ShootingForm form, Forces& forces, const OneStepMethod& method,
+                                            HolonomicConstraints* constraints) {
+  if (constraints != nullptr) {
+    if (form != ShootingForm::lagrangian || !forces.empty() || method.explicit_tableau().stages == 0)
+      throw std::invalid_argument(
+          "with constraints the shooting construction takes the lagrangian form, no forces, and explicit "
+          "Runge-Kutta methods (the constrained field has no Jacobian for implicit stages: its multiplier's "
+          "derivatives need the constraints' third derivatives)");
+    if (!constraints->quadratic())
+      throw std::invalid_argument(
+          "with constraints the shooting construction takes quadratic constraints only (Constraint::quadratic, as "
+          "rod and S2's): its shot carries the constrained field at second-order jets, which would need the "
+          "constraints' third and fourth derivatives");
+    return std::make_unique<ConstrainedField>(lagrangian, *constraints);
+  }
   if (manifold.is_vector_space())
     return std::make_unique<MechanicalField>(lagrangian, phase_space(form), &forces);
   if (!forces.empty())
@@ -53,18 +68,20 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
                                                        Quadrature& quadrature,
                                                        OneStepMethod& method, ShootingForm form,
                                                        SolverOptions options, std::vector<Force*> forces,
-                                                       int jet_capacity)
+                                                       int jet_capacity, HolonomicConstraints* constraints)
     : manifold_(manifold),
       lagrangian_(checked(manifold, lagrangian, form)),
       forces_(std::move(forces), manifold.point_size(), manifold.dim()),
-      field_(field_of(manifold, lagrangian_, form, forces_)),
+      field_(field_of(manifold, lagrangian_, form, forces_, method, constraints)),
       mechanical_(dynamic_cast<MechanicalField*>(field_.get())),
+      constrained_(dynamic_cast<ConstrainedField*>(field_.get())),
+      constraints_(constraints),
       method_(method),
       form_(form),
       options_(options),
       solver_(options),
       m_(manifold.point_size()),
-      n_(manifold.dim()) {
+      n_(manifold.dim() - (constraints != nullptr ? constraints->size() : 0)) {
   method_.set_solver(options.tolerance, options.max_iterations);
   take_quadrature(quadrature);
   refuse_unsupported();
@@ -75,7 +92,8 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   size_workspace();
   if (mechanical_ != nullptr) mechanical_->set_origin(origin_.data());
   offer_explicit_shot(lagrangian);
-  step_ = step_function(n_, manifold_.is_vector_space());
+  step_ = constrained_ != nullptr ? &ShootingDiscreteLagrangian::step_on_constraint
+                                  : step_function(n_, manifold_.is_vector_space());
 }
 
 // The nodes 0 = c_0 < ... < c_n = 1 with zero weights where the rule has no node (paper, sec. 3),
@@ -130,7 +148,7 @@ void ShootingDiscreteLagrangian::size_workspace() {
   zero_.assign(std::max(m_, n_), 0.0);
   slot_.resize(2 * n_);
   acceleration_.resize(n_);
-  gradient_.resize(m_ + n_);
+  gradient_.resize(lagrangian_.position_size() + lagrangian_.velocity_size());
   boundary_.resize(n_);
   end_.resize(m_);
   chart_value_.resize(m_);
@@ -160,6 +178,15 @@ void ShootingDiscreteLagrangian::size_workspace() {
   jacobian_.resize(n_, n_);
   BwT_solver_ = SmallDenseSolver(n_);
   jacobian_solver_ = SmallDenseSolver(n_);
+  if (constrained_ == nullptr) return;
+  start_basis_.resize(m_, n_);
+  end_basis_.resize(m_, n_);
+  normals_.resize(m_, m_ - n_);
+  basis_qr_ = Eigen::HouseholderQR<Eigen::MatrixXd>(m_, m_ - n_);
+  basis_workspace_.resize(m_);
+  chart_momentum_.resize(n_);
+  velocity_.resize(m_);
+  embedded_momentum_.resize(m_);
 }
 
 // Where the step is one recurrence (an explicit method, a constant mass matrix, no forces or end
@@ -286,8 +313,23 @@ void ShootingDiscreteLagrangian::add_work(double weight, const Jet2* v) {
 // chart is q0 + eta, held as the field's origin, and the state's positions are the offsets
 // q^i - (q0 + eta), starting at 0 (position()). Otherwise the manifold's chart gives
 // q0 exp(eta) exp(xi) in (eta, xi), whose xi-derivatives (xi = 0) are dropped: the variables
-// n..2n-1 are w0 here.
-void ShootingDiscreteLagrangian::start_point(const double* q0) {
+// n..2n-1 are w0 here. With constraints (x = (a, w0)) q^0 and v^0 are q0 + N0 a and N0 w0
+// projected onto the constraint and its hidden constraint: a chart of Q at q0, exact at jets.
+void ShootingDiscreteLagrangian::start_point(const double* q0, const double* w0) {
+  if (constrained_ != nullptr) {
+    for (int r = 0; r < m_; ++r) {
+      Jet2& q = state_[r] = seeded(q0[r], -1);
+      Jet2& v = state_[m_ + r] = seeded(0.0, -1);
+      for (int a = 0; a < n_; ++a) {
+        v.value += start_basis_(r, a) * w0[a];
+        if (slot_[a] >= 0) q.gradient[slot_[a]] = start_basis_(r, a);
+        if (slot_[n_ + a] >= 0) v.gradient[slot_[n_ + a]] = start_basis_(r, a);
+      }
+    }
+    constrained_->project(state_.data(), state_.data() + m_, options_);
+    return;
+  }
+  for (int r = 0; r < n_; ++r) state_[m_ + r] = seeded(w0[r], n_ + r);
   if (manifold_.is_vector_space()) {
     for (int r = 0; r < n_; ++r) {
       origin_[r] = seeded(q0[r], r);
@@ -321,8 +363,7 @@ void ShootingDiscreteLagrangian::propagate(const double* q0, const double* w0, d
   }
   std::fill(slot_.begin(), slot_.end(), -1);
   for (std::size_t j = 0; j < pass.variables.size(); ++j) slot_[pass.variables[j]] = static_cast<int>(j);
-  start_point(q0);
-  for (int r = 0; r < n_; ++r) state_[m_ + r] = seeded(w0[r], n_ + r);
+  start_point(q0, w0);
   if (mechanical_ != nullptr && mechanical_->clock()) state_[2 * n_] = Jet2(t_);
   if (mechanical_ != nullptr) mechanical_->set_forced(forced_);
   Jet2 S;
@@ -330,6 +371,7 @@ void ShootingDiscreteLagrangian::propagate(const double* q0, const double* w0, d
   for (std::size_t i = 1; i < nodes_.size(); ++i) {
     field_->step(method_, (nodes_[i] - nodes_[i - 1]) * h, state_.data(), next_.data(), stages_);
     std::swap(state_, next_);
+    if (constrained_ != nullptr) constrained_->project(state_.data(), state_.data() + m_, options_);
     accumulate(static_cast<int>(i), h, S);
   }
   if (type_2()) {
@@ -353,12 +395,23 @@ void ShootingDiscreteLagrangian::propagate(const double* q0, const double* w0, d
 // the offset q^n - (q0 + eta) (the targets subtract q1 - q0; B's derivative in eta is then the
 // offset's plus I, see differentiate()).
 void ShootingDiscreteLagrangian::boundary() {
+  if (target_is_end_ && mechanical_ == nullptr)
+    for (int r = 0; r < m_; ++r) target_[r] = state_[r].value;
+  if (constrained_ != nullptr) {  // B = N1^T (q^n - c), c the target
+    tangent_basis(target_.data(), end_basis_);
+    for (int r = 0; r < n_; ++r) {
+      Jet2& b = boundary_[r] = seeded(0.0, -1);
+      for (int k = 0; k < m_; ++k) {
+        add_scaled(b, end_basis_(k, r), state_[k]);
+        b.value -= end_basis_(k, r) * target_[k];
+      }
+    }
+    return;
+  }
   if (manifold_.is_vector_space()) {
     std::copy_n(state_.begin(), n_, boundary_.begin());
     return;
   }
-  if (target_is_end_)
-    for (int r = 0; r < m_; ++r) target_[r] = state_[r].value;
   for (int r = 0; r < m_; ++r) end_[r] = state_[r].value;
   check(manifold_, manifold_.local_derivatives(target_.data(), end_.data(),
                                     {local_value_.data(), local_gradient_.data(), local_hessian_.data()}),
@@ -424,6 +477,16 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   forced_ = !forces_.empty();
   t_ = t0;
   (this->*step_)(q0, p0, h, q1, p1);
+}
+
+// The last columns of G(q)^T's Householder QR: an orthonormal basis of G(q)'s null space, T_q Q.
+void ShootingDiscreteLagrangian::tangent_basis(const double* q, Eigen::MatrixXd& basis) {
+  constraints_->evaluate_jacobian(q);
+  normals_ = constraints_->jacobian().transpose();
+  basis_qr_.compute(normals_);
+  basis.setZero();
+  basis.bottomRows(n_).setIdentity();
+  basis_qr_.householderQ().applyThisOnTheLeft(basis, basis_workspace_);
 }
 
 const EvaluationCounters& ShootingDiscreteLagrangian::evaluations() const {

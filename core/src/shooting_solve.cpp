@@ -132,12 +132,12 @@ struct ShootingDiscreteLagrangian::Equations {
   // The step's outcome at the updated w0, to first order from the last shot (no propagation):
   // the state's values by their w0-derivatives, lambda by dlambda/dw0 = B_w^{-T} Phi_ww, the
   // momentum change by dD1/dw0 + dlambda/dw0, the residual by its Jacobian.
-  // On a Lie group the point is the state's (one pass, whose variables are x = (eta, w0)); on a
-  // vector space it is read from B.
+  // On a Lie group and with constraints the point is the state's (one pass, whose variables are
+  // x = (eta, w0)); on a vector space it is read from B.
   void finish(const Eigen::VectorXd& update_vector) {
     if (target != Target::momentum) return;
     const Eigen::Map<const Vector<N>> update(update_vector.data(), n);
-    if (!s.manifold_.is_vector_space())
+    if (s.mechanical_ == nullptr)
       for (int r = 0; r < s.m_; ++r)
         if (!s.state_[r].constant()) s.state_[r].value -= s.state_[r].gradient.tail(n).dot(update);
     const Eigen::Map<const Square<N>> Bw(s.Bw_.data(), n, n), jacobian(s.jacobian_.data(), n, n),
@@ -208,6 +208,25 @@ void ShootingDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
   continuing_ = true;
 }
 
+// The step in the charts of Q (shooting.hpp): p0 as N0^T p0, the guess w0 = N0^T M^-1 p0 (the
+// velocity of p0, tangent), the shot from (q0, w0) solved until D1 = -N0^T p0, q1 = q^n and
+// p1 = N1 lambda taken onto the cotangent space. No warm start: the bases change from step to step.
+void ShootingDiscreteLagrangian::step_on_constraint(const double* q0, const double* p0, double h, double* q1,
+                                                    double* p1) {
+  tangent_basis(q0, start_basis_);
+  const Eigen::Map<const Eigen::VectorXd> momentum(p0, m_);
+  chart_momentum_.noalias() = start_basis_.transpose() * momentum;
+  velocity_.noalias() = field_->inverse_mass() * momentum;
+  w_.noalias() = start_basis_.transpose() * velocity_;
+  target_is_end_ = true;
+  solve<Eigen::Dynamic>(q0, h, Target::momentum, chart_momentum_.data());
+  for (int r = 0; r < m_; ++r) q1[r] = state_[r].value;
+  embedded_momentum_.noalias() = end_basis_ * lambda_;
+  velocity_.noalias() = field_->inverse_mass() * embedded_momentum_;
+  constrained_->project_velocity(q1, velocity_.data());
+  Eigen::Map<Eigen::VectorXd>(p1, m_).noalias() = field_->mass() * velocity_;
+}
+
 // The warm start: w0 = guess + c, the correction c = w0 - guess of the step extrapolated from the
 // last steps' (while the steps continue one another at the same h) by the polynomial through up to
 // three of them. The correction is a smooth function of the state along the motion, of the
@@ -239,18 +258,30 @@ void ShootingDiscreteLagrangian::record_correction(double h) {
   previous_h_ = h;
 }
 
-// From the velocity local(q0, q1)/h of the chart's straight line (times M for a momentum).
+// From the velocity local(q0, q1)/h of the chart's straight line (times M for a momentum). With
+// constraints the guess is N0^T (q1 - q0)/h, B = N1^T (q^n - q1) against 0 at N1 = T_q1 Q's basis,
+// and D1, D2 the covectors N0 D1, N1 lambda in R^N.
 void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, double h,
                                           double* Ld, double* D1, double* D2) {
   forced_ = false;  // L_d alone: the forces are not part of it
+  target_is_end_ = false;
+  std::copy_n(q1, m_, target_.begin());
+  if (constrained_ != nullptr) {
+    tangent_basis(q0, start_basis_);
+    velocity_ = (Eigen::Map<const Eigen::VectorXd>(q1, m_) - Eigen::Map<const Eigen::VectorXd>(q0, m_)) / h;
+    w_.noalias() = start_basis_.transpose() * velocity_;
+    solve<Eigen::Dynamic>(q0, h, Target::boundary, zero_.data());
+    if (Ld != nullptr) *Ld = generating_.value;
+    if (D1 != nullptr) Eigen::Map<Eigen::VectorXd>(D1, m_).noalias() = start_basis_ * D1_;
+    if (D2 != nullptr) Eigen::Map<Eigen::VectorXd>(D2, m_).noalias() = end_basis_ * lambda_;
+    return;
+  }
   check(manifold_, manifold_.local(q0, q1, w_.data()), "manifold chart");
   w_ /= h;
   if (form_ != ShootingForm::lagrangian) {  // p0's guess: the momentum of that velocity at q0
     v_values_ = w_;
     mechanical_->momentum(q0, v_values_.data(), w_.data());
   }
-  target_is_end_ = false;
-  std::copy_n(q1, m_, target_.begin());
   // On a vector space B = q^n - q0 against q1 - q0 (type-2: lambda, an offset too, against it);
   // through the chart at q1, B = local(q1, q^n) against 0.
   if (mechanical_ != nullptr) {
@@ -276,6 +307,8 @@ void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
 // a Runge-Kutta method integrating in the embedding leaves (its g^n is off the group by its local
 // error): only a Lie group method's shot has it.
 std::string ShootingDiscreteLagrangian::tangent_map_refusal() const {
+  if (constrained_ != nullptr)
+    return "the shooting construction with constraints has no tangent map (its projected shot's is not derived)";
   if (mechanical_ == nullptr && std::string(method_.equivariance()) != "left")
     return "the shooting construction's tangent map on a Lie group takes a Lie group method (as crouch-grossman), "
            "whose shot stays on the group; a Runge-Kutta method integrates in the embedding and leaves it";

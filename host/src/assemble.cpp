@@ -48,7 +48,7 @@ void create_constraints(const Scene& scene, Registry& registry, Assembly& a) {
                                              scene.manifold.type)
                                : "constraints are";
   if (!scene.construction->takes_constraints(a.manifold->structure()))
-    throw InputError(fmt::format("{}: {} taken by the galerkin and one-step constructions on vector spaces "
+    throw InputError(fmt::format("{}: {} taken by the galerkin, one-step and shooting constructions on vector spaces "
                                  "(docs/constraints.md), not by '{}' on the {} manifold",
                                  pointer, what, scene.construction->name(), scene.manifold.type));
   if (!has_constant_mass_matrix(*a.lagrangian))

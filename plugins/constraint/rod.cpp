@@ -99,6 +99,7 @@ class Rod final : public varia::Constraint {
     }
     return nullptr;
   }
+  bool quadratic() const noexcept override { return true; }  // |x_i - x_j|^2: a constant Hessian
   varia::Status weighted_hessian(const double*, const double* lambda, double* values) noexcept override {
     std::fill_n(values, hessian_.size(), 0.0);
     const double scale = 1.0 / (length_ * length_);

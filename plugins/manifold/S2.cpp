@@ -53,6 +53,7 @@ class UnitNorm final : public varia::Constraint {
     if (jacobian != nullptr) std::copy_n(q, 3, jacobian);
     return nullptr;
   }
+  bool quadratic() const noexcept override { return true; }
   varia::Status weighted_hessian(const double* /*q*/, const double* lambda, double* values) noexcept override {
     std::fill_n(values, 3, lambda[0]);
     return nullptr;

@@ -123,6 +123,9 @@ class ProductEquations final : public varia::Constraint {
                                    jacobian != nullptr ? jacobian + b.jacobian_first : nullptr);
     });
   }
+  bool quadratic() const noexcept override {
+    return std::all_of(blocks_.begin(), blocks_.end(), [](const Block& b) { return b.equations->quadratic(); });
+  }
   Status weighted_hessian(const double* q, const double* lambda, double* values) noexcept override {
     return each([&](const Block& b) {
       return b.equations->weighted_hessian(q + b.point_offset, lambda + b.first_row, values + b.hessian_first);

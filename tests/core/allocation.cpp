@@ -67,8 +67,10 @@ long allocations_of_stepping(DiscreteHamiltonianMap& map, Eigen::VectorXd q, Eig
   });
 }
 
-// A unit sphere in R^3 as one holonomic constraint, g = (|q|^2 - 1)/2.
+// A unit sphere in R^3 as one holonomic constraint, g = (|q|^2 - 1)/2, declared quadratic or not.
 struct UnitSphere final : Constraint {
+  bool declared_quadratic = true;
+  bool quadratic() const noexcept override { return declared_quadratic; }
   Status bind(int, int) noexcept override { return nullptr; }
   int size() const noexcept override { return 1; }
   int jacobian_pattern(const int** rows, const int** cols) const noexcept override {
@@ -124,6 +126,25 @@ TEST_CASE("one-step rk4 with a constraint (the index-1 field, then the projectio
   const Eigen::VectorXd q = (Eigen::VectorXd(3) << std::sin(1.0), 0.0, -std::cos(1.0)).finished();
   const Eigen::VectorXd p = (Eigen::VectorXd(3) << 0.0, 2.5, 0.0).finished();
   CHECK(allocations_of_stepping(map, q, p, 0.01, 50) == 0);
+}
+
+TEST_CASE("shooting rk4 + simpson with a constraint allocates nothing per step, and takes quadratic constraints only") {
+  FlatSpace space(3);
+  FallingMass mass;
+  UnitSphere sphere;
+  HolonomicConstraints constraints({&sphere}, 3);
+  sdk::RungeKutta method = rk4();
+  auto rule = simpson();
+  ShootingDiscreteLagrangian map(space, mass, rule, method, ShootingForm::lagrangian, {}, {}, kMaxJetVariables,
+                                 &constraints);
+  const Eigen::VectorXd q = (Eigen::VectorXd(3) << std::sin(1.0), 0.0, -std::cos(1.0)).finished();
+  const Eigen::VectorXd p = (Eigen::VectorXd(3) << 0.0, 2.5, 0.0).finished();
+  CHECK(allocations_of_stepping(map, q, p, 0.01, 50) == 0);
+  sphere.declared_quadratic = false;
+  HolonomicConstraints undeclared({&sphere}, 3);
+  CHECK_THROWS_WITH_AS(ShootingDiscreteLagrangian(space, mass, rule, method, ShootingForm::lagrangian, {}, {},
+                                                  kMaxJetVariables, &undeclared),
+                       doctest::Contains("quadratic constraints only"), std::invalid_argument);
 }
 
 // The same pendulums not declaring their mass matrix: Newton with the exact Jacobian.

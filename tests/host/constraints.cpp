@@ -7,6 +7,7 @@
 
 #include <Eigen/LU>
 #include <array>
+#include <tuple>
 #include <vector>
 #include <boost/numeric/odeint.hpp>
 #include <cmath>
@@ -114,6 +115,22 @@ TEST_CASE("the spherical pendulum on a rod: projected explicit midpoint and rk4 
   for (const auto& [type, order] : methods) {
     CAPTURE(type);
     const OrderFit fit = spherical_pendulum_order({{"construction", "one-step"}, {"one_step", {{"type", type}}}}, 0.02);
+    CHECK(fit.used == 4);
+    CHECK(std::abs(fit.slope - order) <= 0.25);
+  }
+}
+
+json constrained_shooting(const char* method, const char* rule) {
+  return {{"construction", "shooting"}, {"one_step", {{"type", method}}}, {"quadrature", {{"type", rule}}}};
+}
+
+// Shooting with constraints: the shot is the projected one-step map, L_d a function on the sphere's
+// Q x Q; the paper's theorem there gives order min(p, q).
+TEST_CASE("the spherical pendulum on a rod: shooting with projected explicit midpoint + trapezoid and rk4 + simpson has orders 2 and 4") {
+  const std::tuple<const char*, const char*, int> methods[] = {{"explicit-midpoint", "trapezoid", 2}, {"rk4", "simpson", 4}};
+  for (const auto& [type, rule, order] : methods) {
+    CAPTURE(type);
+    const OrderFit fit = spherical_pendulum_order(constrained_shooting(type, rule), 0.02);
     CHECK(fit.used == 4);
     CHECK(std::abs(fit.slope - order) <= 0.25);
   }
@@ -233,19 +250,25 @@ TEST_CASE("pendulum-chain on S2 x S2 agrees with the double spherical pendulum's
 }
 
 // One rod of length 1 and mass 1: S2's equation (|q|^2 - 1)/2 is the rod's, and the Lagrangians are
-// equal, so the two forms take the same steps up to round-off.
-TEST_CASE("pendulum-chain on S2 takes the steps of the particle on a rod") {
+// equal, so the two forms take the same steps up to round-off, under Galerkin (the scenes' own
+// method) and under shooting with constraints.
+TEST_CASE("pendulum-chain on S2 takes the steps of the particle on a rod, under Galerkin and shooting") {
   Registry registry{Registry::search_path({})};
-  Scene sphere_scene, rod_scene;
-  Assembly sphere = assembled(scene_file("spherical-pendulum-s2.json"), registry, sphere_scene);
-  Assembly rod = assembled(scene_file("spherical-pendulum-rod-s2.json"), registry, rod_scene);
-  Trajectory on_sphere(*sphere.map, sphere.q0, sphere.p0, sphere.t0, sphere_scene.step);
-  Trajectory on_rod(*rod.map, rod.q0, rod.p0, rod.t0, rod_scene.step);
-  on_sphere.advance(1000);
-  on_rod.advance(1000);
-  const double difference = (on_sphere.q() - on_rod.q()).lpNorm<Eigen::Infinity>();
-  MESSAGE("S2 against the rod after 1000 steps: ", difference);
-  CHECK(difference <= 1e-12);
+  json sphere_document = scene_file("spherical-pendulum-s2.json"), rod_document = scene_file("spherical-pendulum-rod-s2.json");
+  for (const json& method : {sphere_document["method"], constrained_shooting("rk4", "simpson")}) {
+    CAPTURE(method.dump());
+    sphere_document["method"] = rod_document["method"] = method;
+    Scene sphere_scene, rod_scene;
+    Assembly sphere = assembled(sphere_document, registry, sphere_scene);
+    Assembly rod = assembled(rod_document, registry, rod_scene);
+    Trajectory on_sphere(*sphere.map, sphere.q0, sphere.p0, sphere.t0, sphere_scene.step);
+    Trajectory on_rod(*rod.map, rod.q0, rod.p0, rod.t0, rod_scene.step);
+    on_sphere.advance(1000);
+    on_rod.advance(1000);
+    const double difference = (on_sphere.q() - on_rod.q()).lpNorm<Eigen::Infinity>();
+    MESSAGE("S2 against the rod after 1000 steps: ", difference);
+    CHECK(difference <= 1e-12);
+  }
 }
 
 // Noether with the manifold's own constraint: |q_i| = 1 is invariant under rotations about e3.
@@ -296,9 +319,9 @@ TEST_CASE("on S2 x S2 a momentum is read and written orthogonal to the normals, 
 TEST_CASE("S2 is refused where it cannot be served, and a point off the sphere at /initial/q") {
   Registry registry{Registry::search_path({})};
   Scene scene;
-  json shooting = scene_file("spherical-pendulum-s2.json");
-  shooting["method"] = {{"construction", "shooting"}, {"one_step", {{"type", "rk4"}}}, {"quadrature", {{"type", "simpson"}}}};
-  CHECK_THROWS_WITH_AS(assembled(shooting, registry, scene), doctest::Contains("/system/manifold"), InputError);
+  json implicit = scene_file("spherical-pendulum-s2.json");
+  implicit["method"] = constrained_shooting("implicit-midpoint", "simpson");
+  CHECK_THROWS_WITH_AS(assembled(implicit, registry, scene), doctest::Contains("/method: with constraints"), InputError);
   json off = scene_file("spherical-pendulum-s2.json");
   off["initial"]["q"] = {0.85, 0, -0.54};
   CHECK_THROWS_WITH_AS(assembled(off, registry, scene), doctest::Contains("/initial/q"), InputError);
@@ -310,9 +333,11 @@ TEST_CASE("S2 is refused where it cannot be served, and a point off the sphere a
 TEST_CASE("constraints are refused where they cannot be served, and a start off them is refused at its pointer") {
   Registry registry{Registry::search_path({})};
   Scene scene;
-  json shooting = spherical_pendulum(1, 0.01, 10);
-  shooting["method"] = {{"construction", "shooting"}, {"one_step", {{"type", "rk4"}}}, {"quadrature", {{"type", "simpson"}}}};
-  CHECK_THROWS_WITH_AS(assembled(shooting, registry, scene), doctest::Contains("/system/constraints"), InputError);
+  json hamiltonian = spherical_pendulum(1, 0.01, 10);
+  hamiltonian["method"] = constrained_shooting("rk4", "simpson");
+  hamiltonian["method"]["form"] = "hamiltonian";
+  CHECK_THROWS_WITH_AS(assembled(hamiltonian, registry, scene), doctest::Contains("/method: with constraints"),
+                       InputError);
   json implicit = spherical_pendulum(1, 0.01, 10);
   implicit["method"] = {{"construction", "one-step"}, {"one_step", {{"type", "implicit-midpoint"}}}};
   CHECK_THROWS_WITH_AS(assembled(implicit, registry, scene), doctest::Contains("/method/one_step: with constraints"),
@@ -355,28 +380,42 @@ class DampedMap final : public DiscreteHamiltonianMap {
 
 }  // namespace
 
-TEST_CASE("symplecticity on the constraint's cotangent bundle: holds for the constrained Galerkin map, not for a damped one") {
+TEST_CASE("symplecticity on the constraint's cotangent bundle: holds for the constrained Galerkin and shooting maps, not for a damped one") {
   Registry registry{Registry::search_path({})};
-  Scene scene;
-  Assembly a = assembled(spherical_pendulum(2, 0.01, 10), registry, scene);
-  const Eigen::MatrixXd M = Eigen::MatrixXd::Identity(3, 3);
-  const Eigen::MatrixXd tangent = constrained_tangent_basis(*a.holonomic, M, a.q0.data(), a.p0.data(), 1e-3, 2.5e-3);
-  REQUIRE(tangent.cols() == 4);
-  const Eigen::VectorXd steps = Eigen::VectorXd::Constant(6, 1e-3);
-  const auto held = symplecticity_defect(*a.map, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps, tangent);
-  CHECK(held.defect <= 1e-9);
-  DampedMap damped(*a.map);
-  const auto broken = symplecticity_defect(damped, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps, tangent);
-  CHECK(broken.defect >= 1e-3);
-  // On the whole of T*R^3 the constrained map is not symplectic (it maps onto the bundle): the
-  // unrestricted measurement would call a correct integrator wrong, which is why verify restricts it.
-  const auto whole = symplecticity_defect(*a.map, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps);
-  CHECK(whole.defect >= 1e-3);
+  for (const json& method : {galerkin_lobatto(2), constrained_shooting("rk4", "simpson")}) {
+    CAPTURE(method.dump());
+    Scene scene;
+    Assembly a = assembled(spherical_pendulum(method, 0.01, 10), registry, scene);
+    const Eigen::MatrixXd M = Eigen::MatrixXd::Identity(3, 3);
+    const Eigen::MatrixXd tangent = constrained_tangent_basis(*a.holonomic, M, a.q0.data(), a.p0.data(), 1e-3, 2.5e-3);
+    REQUIRE(tangent.cols() == 4);
+    const Eigen::VectorXd steps = Eigen::VectorXd::Constant(6, 1e-3);
+    const auto held = symplecticity_defect(*a.map, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps, tangent);
+    MESSAGE("symplecticity defect on the bundle: ", held.defect);
+    CHECK(held.defect <= 1e-9);
+    DampedMap damped(*a.map);
+    const auto broken = symplecticity_defect(damped, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps, tangent);
+    CHECK(broken.defect >= 1e-3);
+    // On the whole of T*R^3 the constrained map is not symplectic (it maps onto the bundle): the
+    // unrestricted measurement would call a correct integrator wrong, which is why verify restricts it.
+    const auto whole = symplecticity_defect(*a.map, *a.manifold, a.q0.data(), a.p0.data(), 0.05, steps);
+    CHECK(whole.defect >= 1e-3);
+  }
 }
 
 TEST_CASE("varia verify holds every predicted property of the constrained spherical pendulum, s = 1, 2, 3") {
   for (int s = 1; s <= 3; ++s) {
     const auto outcome = test::run_varia("verify scenes/multibody/spherical-pendulum-rod-s" + std::to_string(s) + ".json");
+    CAPTURE(outcome.out);
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == 0);
+    CHECK(test::contains(outcome.out, "global_order"));
+  }
+}
+
+TEST_CASE("varia verify holds every predicted property of shooting with constraints: a rod, and S2 x S2 with its momentum") {
+  for (const char* name : {"spherical-pendulum-rod-shooting.json", "double-spherical-pendulum-s2-shooting.json"}) {
+    const auto outcome = test::run_varia(std::string("verify scenes/multibody/") + name);
     CAPTURE(outcome.out);
     CAPTURE(outcome.err);
     CHECK(outcome.code == 0);

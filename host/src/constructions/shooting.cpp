@@ -21,6 +21,11 @@ class Shooting final : public Construction {
  public:
   const char* name() const override { return "shooting"; }
   bool takes_forces() const override { return true; }
+  // With quadratic constraints on a vector space (docs/constraints.md): the shot is the constrained
+  // one-step map, the construction runs in charts of the constraint manifold (core/shooting.hpp).
+  bool takes_constraints(ManifoldStructure structure) const override {
+    return structure == ManifoldStructure::vector_space;
+  }
 
   json schema() const override {
     return method_schema(
@@ -46,7 +51,8 @@ class Shooting final : public Construction {
     try {
       auto map = std::make_unique<ShootingDiscreteLagrangian>(*a.manifold, *a.lagrangian, *a.quadrature,
                                                               *a.one_step, shooting_form(options(scene).form),
-                                                              scene.solver, forces_of(a));
+                                                              scene.solver, forces_of(a), kMaxJetVariables,
+                                                              a.holonomic.get());
       a.discrete_lagrangian = map.get();
       a.map = std::move(map);
     } catch (const std::invalid_argument& e) {
@@ -69,6 +75,13 @@ class Shooting final : public Construction {
     p.symplectic = p.energy_bounded = true;
     p.reason = "shooting (sec. 3 theorem): order min(p, q); self-adjoint for a self-adjoint method and a symmetric "
                "rule (Type I form; no prediction for type-2); G-invariant for a G-equivariant method";
+    if (a.holonomic) {  // L_d's own order is not measured: verify's sampled pairs leave Q (docs/constraints.md)
+      p.self_adjoint.reset();
+      p.ld_order.reset();
+      p.reason += "; with constraints the shot is the method's index-1 steps each projected onto the constraint "
+                  "(Hairer, Lubich & Wanner, sec. IV.4), of order p, not self-adjoint: the theorem on the "
+                  "constraint manifold Q, L_d a function on Q x Q (symplectic on Q), no self-adjointness predicted";
+    }
     apply_shared_theorems(a, method.equivariant, p);
     if (!method.stays_on_group) {
       p.symplectic.reset();

@@ -3,7 +3,7 @@
 // of sum_i lambda_i g_i for given multipliers lambda, which the constructions need for the exact
 // Newton Jacobian of the constrained discrete Euler-Lagrange equations (docs/constraints.md).
 // Model evaluations only: a construction decides where and with which multipliers g enters.
-// ABI 16.
+// ABI 16; quadratic() ABI 18.
 #pragma once
 
 #include "varia/abi/plugin_object.hpp"
@@ -29,6 +29,12 @@ class Constraint : public PluginObject {
   virtual Status evaluate(const double* q, double* g, double* jacobian) noexcept = 0;
   // The Hessian of sum_i lambda_i g_i at q, its values in hessian_pattern's order.
   virtual Status weighted_hessian(const double* q, const double* lambda, double* values) noexcept = 0;
+  // Whether every g_i is a quadratic polynomial in q, so that the Hessian of sum_i lambda_i g_i does
+  // not depend on q (the rod, S2's sphere). The shooting construction takes such constraints only:
+  // it propagates the constrained field at second-order jets, where G and the Hessians at a jet
+  // follow exactly from their values at one point (docs/constraints.md). The SDK's conformance
+  // suite checks the declaration (the Hessian at random points).
+  virtual bool quadratic() const noexcept { return false; }
 };
 
 }  // namespace varia

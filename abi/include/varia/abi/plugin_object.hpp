@@ -29,7 +29,8 @@ namespace varia {
 // versions either: a plugin that lacks one keeps loading, and is refused only where it is needed.
 // 16: the constraint kind (constraint.hpp, Kind::constraint); Lagrangian::space_dim.
 // 17: Manifold::defining_constraint (an embedded manifold served with its equations' multipliers).
-inline constexpr int kAbiVersion = 17;
+// 18: Constraint::quadratic (a constant Hessian, which the shooting construction's shot needs).
+inline constexpr int kAbiVersion = 18;
 
 using Status = const char*;
 

@@ -27,6 +27,8 @@ class HolonomicConstraints {
   HolonomicConstraints(std::vector<Constraint*> constraints, int n);
   int size() const { return m_; }
   int dim() const { return n_; }
+  // Whether every constraint declares itself quadratic (Constraint::quadratic: a constant Hessian).
+  bool quadratic() const;
   // g(q), m numbers.
   void values(const double* q, double* g);
   // G(q) into jacobian() (and g(q) into g when not null).

@@ -54,6 +54,18 @@
 // momenta are body momenta, as lie-verlet's. The lagrangian form only, no forces, no end-derivative
 // quadratures there.
 //
+// With holonomic constraints g(q) = 0 on R^N (HolonomicConstraints, quadratic ones: docs/constraints.md)
+// the shot is the constrained one-step map (constrained_field.hpp): an explicit Runge-Kutta step of
+// the index-1 field, then the projection onto the constraint and its hidden constraint, at jets.
+// L_d is then a function on Q x Q, Q = {g = 0} of dimension n = N - m, and the construction runs in
+// charts of Q: x = (a, w0) in R^2n with q^0, v^0 the projections of q0 + N0 a and N0 w0 (N0 an
+// orthonormal basis of T_q0 Q), and B = N1^T (q^n - c) (N1 one of T_c Q, c = q1 or, in a step,
+// q^n's value). D1 and lambda = D2 are then covectors on T_q0 Q and T_q1 Q in those bases: p0 is
+// read as N0^T p0, and p1 = N1 lambda is taken onto the cotangent space as the projection's M v
+// with G(q1) v = 0 (the momenta the Galerkin construction holds). Its theorem is the
+// unconstrained one on Q: order min(p, q) for the projected method's order p, symplectic on Q.
+// The lagrangian form only, no forces, a constant mass matrix, explicit methods, no tangent map.
+//
 // Sensitivities in passes: a jet holds at most kMaxJetVariables = 12 variables, or fewer where the
 // field's derivatives at jets take fewer (MechanicalField::jet_variables). Where 2n exceeds that
 // (on R^n or on a Lie group),
@@ -74,10 +86,12 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
+#include <Eigen/QR>
 #include <memory>
 #include <string>
 #include <vector>
 
+#include "varia/core/constrained_field.hpp"
 #include "varia/core/discrete_hamiltonian_map.hpp"
 #include "varia/abi/force.hpp"
 #include "varia/abi/manifold.hpp"
@@ -101,10 +115,13 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // The method's stage solves use options too. Throws std::invalid_argument for an unsupported
   // manifold, Lagrangian or quadrature, or forces with the type_2 form or an end-derivative rule.
   // jet_capacity: the most variables of a pass's jets (at most kMaxJetVariables; fewer: more
-  // passes of smaller jets, the same derivatives).
+  // passes of smaller jets, the same derivatives). constraints: holonomic constraints on the
+  // vector space (quadratic ones; throws std::invalid_argument otherwise, or for another form,
+  // forces or an implicit method with them).
   ShootingDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian, Quadrature& quadrature,
                              OneStepMethod& method, ShootingForm form, SolverOptions options,
-                             std::vector<Force*> forces = {}, int jet_capacity = kMaxJetVariables);
+                             std::vector<Force*> forces = {}, int jet_capacity = kMaxJetVariables,
+                             HolonomicConstraints* constraints = nullptr);
 
   // L_d(q0, q1), D1 L_d, D2 L_d (any output may be null): the boundary-value problem
   // q^n(q0, w0) = q1 solved for w0 by Newton's method. In the type_2 form, L_d is the Legendre
@@ -113,7 +130,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void evaluate(const double* q0, const double* q1, double h, double* Ld, double* D1,
                 double* D2) override;
   int point_size() const override { return m_; }
-  int dim() const override { return n_; }
+  int dim() const override { return manifold_.dim(); }
   // The shooting Newton iteration (one solve per step or evaluation).
   const SolverStatistics& solver_statistics() const override { return statistics_; }
   // The one-step method's stage solves (zeros for explicit methods).
@@ -156,8 +173,12 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // variables, or a jet of zero derivatives in them. Every pass's jets have jet_size_ variables,
   // its unused ones with zero derivatives: a one-step method's workspace then keeps its size.
   Jet2 seeded(double value, int variable) const;
-  void start_point(const double* q0);
+  void start_point(const double* q0, const double* w0);
   void boundary();
+  // With constraints: an orthonormal basis of T_q Q (N x n) into `basis`.
+  void tangent_basis(const double* q, Eigen::MatrixXd& basis);
+  // The step with constraints (step_ there): in the charts of Q at q0 and q1 (see above).
+  void step_on_constraint(const double* q0, const double* p0, double h, double* q1, double* p1);
   // The members templated on N do the shooting Newton's algebra on vectors of N = n numbers and
   // N x N matrices, N fixed at compile time on R^n for n <= 4 (fixed_size.hpp: chosen once, step_),
   // else Eigen::Dynamic.
@@ -196,7 +217,9 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   LagrangianEvaluator lagrangian_;
   Forces forces_;
   std::unique_ptr<EulerLagrangeField> field_;
-  MechanicalField* mechanical_;  // field_ on a vector space, else null
+  MechanicalField* mechanical_;  // field_ on a vector space without constraints, else null
+  ConstrainedField* constrained_;  // field_ with constraints, else null
+  HolonomicConstraints* constraints_;
   OneStepMethod& method_;
   ShootingForm form_;
   SolverOptions options_;
@@ -251,6 +274,11 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // directions' right-hand sides and dw0 (n x count).
   Eigen::MatrixXd tangent_lambda_, tangent_d1_, tangent_rhs_, tangent_w_;
   Eigen::PartialPivLU<Eigen::MatrixXd> tangent_bw_lu_, tangent_lu_;
+  // With constraints: the charts' bases N0, N1 (N x n), G^T and its QR (the bases' source), the
+  // momentum p0 on T_q0 Q (n numbers), a velocity and a momentum in R^N.
+  Eigen::MatrixXd start_basis_, end_basis_, normals_;
+  Eigen::HouseholderQR<Eigen::MatrixXd> basis_qr_;
+  Eigen::VectorXd basis_workspace_, chart_momentum_, velocity_, embedded_momentum_;
 };
 
 }  // namespace varia

@@ -6,7 +6,8 @@
 //     (its pattern's values in an n x n matrix) is symmetric;
 //   - Taylor tests along random directions d (taylor.hpp): g(q + eps d) - g(q) - eps G d and
 //     G(q + eps d)^T lambda - G(q)^T lambda - eps H_lambda d fall as eps^2. A wrong Jacobian fails the
-//     first, a wrong or missing Hessian entry the second.
+//     first, a wrong or missing Hessian entry the second;
+//   - a constraint declaring quadratic() has the same Hessian at every random point.
 #pragma once
 
 #include <Eigen/Core>
@@ -88,6 +89,11 @@ inline Failures check_constraint(Constraint& constraint, int n, std::mt19937& en
           return (G.transpose() * lambda - c.G.transpose() * lambda - eps * H * d).norm();
         },
         std::max(scale, H.lpNorm<Eigen::Infinity>()), "the weighted Hessian is not the derivative of G^T lambda");
+    if (constraint.quadratic()) {
+      const Eigen::MatrixXd elsewhere = weighted_hessian(constraint, random_point(n, engine), lambda);
+      failures.expect((elsewhere - H).lpNorm<Eigen::Infinity>() <= 1e-14 * std::max(1.0, H.lpNorm<Eigen::Infinity>()),
+                      "the constraint declares quadratic(), but its Hessian differs between points");
+    }
   }
   return failures;
 }
