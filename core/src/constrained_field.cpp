@@ -26,7 +26,15 @@ ConstrainedField::ConstrainedField(LagrangianEvaluator& lagrangian, HolonomicCon
       values_(m_),
       unit_(Eigen::VectorXd::Zero(m_)),
       lu_(m_),
-      jet_solve_(m_) {
+      jet_solve_(m_),
+      lagrangian_hessian_(2 * n_, 2 * n_),
+      free_jacobian_(n_, 2 * n_),
+      R_(m_, 2 * n_),
+      K_(n_, n_),
+      dense_hessian_(n_, n_),
+      weighted_(n_),
+      product_(n_),
+      scratch_(n_) {
   if (!constant_mass_)
     throw std::invalid_argument("constraints need a Lagrangian with a constant mass matrix");
   const auto size = [&](auto& w) {
@@ -159,6 +167,48 @@ Status ConstrainedField::eval(const double* y, double* f) noexcept { return eval
 Status ConstrainedField::eval(const Jet2* y, Jet2* f) noexcept {
   if (!quadratic_) return "the constrained field at jets takes quadratic constraints only (Constraint::quadratic)";
   return evaluate(y, f);
+}
+
+// The derivative of a = u - W lambda in z = (q, v), u = M^-1 L_q, for quadratic constraints
+// (dG_i/dq = H_i, dc/dq = 0): with r = W lambda and H_lambda = sum_i lambda_i H_i,
+//   S dlambda = R dz,  R = G du + [((H_i (u - r))^T, 2 (H_i v)^T)]_i - [G M^-1 H_lambda, 0],
+//   da = du - [M^-1 H_lambda, 0] dz - W dlambda.
+Status ConstrainedField::jacobian(const double* y, double* f, double* df) noexcept {
+  if (!quadratic_) return "the constrained field (index 1) has a Jacobian for quadratic constraints only: its "
+                          "multiplier's derivatives would need the constraints' third derivatives";
+  if (Status status = evaluate(y, f)) return status;
+  return guard([&] {
+    Workspace<double>& w = doubles_;
+    const Eigen::Map<const Eigen::VectorXd> v(y + n_, n_);
+    lagrangian_.hessian(y, y + n_, w.gradient.data(), lagrangian_hessian_.data());
+    free_jacobian_.noalias() = inverse_mass_ * lagrangian_hessian_.topRows(n_);
+    weighted_.noalias() = w.W * w.multiplier;
+    R_.noalias() = w.GT.transpose() * free_jacobian_;
+    product_ = w.free - weighted_;
+    for (int i = 0; i < m_; ++i) {
+      unit_[i] = 1.0;
+      constraints_.evaluate_hessian(y, unit_.data());
+      unit_[i] = 0.0;
+      scratch_.noalias() = constraints_.hessian() * product_;
+      R_.row(i).head(n_) += scratch_.transpose();
+      scratch_.noalias() = constraints_.hessian() * v;
+      R_.row(i).tail(n_) += 2.0 * scratch_.transpose();
+    }
+    constraints_.evaluate_hessian(y, w.multiplier.data());
+    dense_hessian_ = constraints_.hessian();
+    K_.noalias() = inverse_mass_ * dense_hessian_;
+    R_.leftCols(n_).noalias() -= w.GT.transpose() * K_;
+    Eigen::Map<Eigen::MatrixXd> J(df, 2 * n_, 2 * n_);
+    J.setZero();
+    J.topRightCorner(n_, n_).setIdentity();
+    J.bottomRows(n_) = free_jacobian_;
+    J.bottomLeftCorner(n_, n_) -= K_;
+    lu_.compute(w.S);
+    for (int c = 0; c < 2 * n_; ++c) {
+      w.rhs = lu_.solve(R_.col(c));
+      J.col(c).tail(n_).noalias() -= w.W * w.rhs;
+    }
+  });
 }
 
 // q = q^ - W(q^) mu with g(q) = 0 by Newton's method in mu (Jacobian G(q) W(q^)); at jets two

@@ -12,13 +12,16 @@ namespace {
 std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvaluator& lagrangian,
                                              const OneStepMethod& method, HolonomicConstraints* constraints) {
   if (constraints != nullptr) {
-    if (!manifold.is_vector_space() || method.explicit_tableau().stages == 0)
-      throw std::invalid_argument(
-          "with constraints the one-step construction takes explicit Runge-Kutta methods on vector spaces only (the "
-          "constrained field has no Jacobian for implicit stages: its multiplier's derivatives need the constraints' "
-          "third derivatives)");
+    if (!manifold.is_vector_space())
+      throw std::invalid_argument("with constraints the one-step construction takes vector spaces only");
     require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");
-    return std::make_unique<ConstrainedField>(lagrangian, *constraints);
+    auto field = std::make_unique<ConstrainedField>(lagrangian, *constraints);
+    if (method.explicit_tableau().stages == 0 && !field->has_jacobian())
+      throw std::invalid_argument(
+          "with constraints that are not quadratic the one-step construction takes explicit Runge-Kutta methods only "
+          "(an implicit method's stages need the constrained field's Jacobian, whose multiplier's derivatives need "
+          "the constraints' third derivatives)");
+    return field;
   }
   if (!manifold.is_vector_space()) return std::make_unique<LieGroupField>(manifold, lagrangian);
   require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");

@@ -32,14 +32,10 @@ Lagrangian& checked(const Manifold& manifold, Lagrangian& lagrangian, ShootingFo
 // forces; with constraints the constrained field in (q, v) (constrained_field.hpp); on a Lie group
 // in (g, xi) (the Euler-Poincare field, lie_group_field.hpp).
 std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvaluator& lagrangian,
-                                            ShootingForm form, Forces& forces, const OneStepMethod& method,
-                                            HolonomicConstraints* constraints) {
+                                            ShootingForm form, Forces& forces, HolonomicConstraints* constraints) {
   if (constraints != nullptr) {
-    if (form != ShootingForm::lagrangian || !forces.empty() || method.explicit_tableau().stages == 0)
-      throw std::invalid_argument(
-          "with constraints the shooting construction takes the lagrangian form, no forces, and explicit "
-          "Runge-Kutta methods (the constrained field has no Jacobian for implicit stages: its multiplier's "
-          "derivatives need the constraints' third derivatives)");
+    if (form != ShootingForm::lagrangian || !forces.empty())
+      throw std::invalid_argument("with constraints the shooting construction takes the lagrangian form and no forces");
     if (!constraints->quadratic())
       throw std::invalid_argument(
           "with constraints the shooting construction takes quadratic constraints only (Constraint::quadratic, as "
@@ -72,7 +68,7 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
     : manifold_(manifold),
       lagrangian_(checked(manifold, lagrangian, form)),
       forces_(std::move(forces), manifold.point_size(), manifold.dim()),
-      field_(field_of(manifold, lagrangian_, form, forces_, method, constraints)),
+      field_(field_of(manifold, lagrangian_, form, forces_, constraints)),
       mechanical_(dynamic_cast<MechanicalField*>(field_.get())),
       constrained_(dynamic_cast<ConstrainedField*>(field_.get())),
       constraints_(constraints),

@@ -9,6 +9,7 @@
 #include <cmath>
 #include <cstddef>
 
+#include "core/constraint_fixtures.hpp"
 #include "core/fixtures.hpp"
 #include "core/shooting_fixtures.hpp"
 #include "varia/core/galerkin.hpp"
@@ -67,43 +68,6 @@ long allocations_of_stepping(DiscreteHamiltonianMap& map, Eigen::VectorXd q, Eig
   });
 }
 
-// A unit sphere in R^3 as one holonomic constraint, g = (|q|^2 - 1)/2, declared quadratic or not.
-struct UnitSphere final : Constraint {
-  bool declared_quadratic = true;
-  bool quadratic() const noexcept override { return declared_quadratic; }
-  Status bind(int, int) noexcept override { return nullptr; }
-  int size() const noexcept override { return 1; }
-  int jacobian_pattern(const int** rows, const int** cols) const noexcept override {
-    static constexpr int r[3] = {0, 0, 0}, c[3] = {0, 1, 2};
-    *rows = r;
-    *cols = c;
-    return 3;
-  }
-  int hessian_pattern(const int** rows, const int** cols) const noexcept override {
-    static constexpr int c[3] = {0, 1, 2};
-    *rows = c;
-    *cols = c;
-    return 3;
-  }
-  Status evaluate(const double* q, double* g, double* G) noexcept override {
-    if (g != nullptr) g[0] = 0.5 * (q[0] * q[0] + q[1] * q[1] + q[2] * q[2] - 1.0);
-    if (G != nullptr) std::copy_n(q, 3, G);
-    return nullptr;
-  }
-  Status weighted_hessian(const double*, const double* lambda, double* values) noexcept override {
-    std::fill_n(values, 3, lambda[0]);
-    return nullptr;
-  }
-};
-
-// A unit mass in gravity along -e3, L = |v|^2/2 - q3, on R^3.
-struct FallingMass : sdk::AutodiffLagrangian<FallingMass, 3, 3> {
-  template <class T>
-  T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
-    return 0.5 * (v(0) * v(0) + v(1) * v(1) + v(2) * v(2)) - q(2);
-  }
-};
-
 // 50 steps by step() and 50 by advance() on R^n.
 long allocations_of_steps(GalerkinDiscreteLagrangian& map, int n) {
   return allocations_of_stepping(map, Eigen::VectorXd::LinSpaced(n, 1.3, 0.2), Eigen::VectorXd::Zero(n), 0.1, 50, true);
@@ -116,16 +80,23 @@ TEST_CASE("allocations are counted: resizing a dynamic vector allocates") {
   CHECK(allocations_of([&] { v.resize(1000); }) >= 1);
 }
 
-TEST_CASE("one-step rk4 with a constraint (the index-1 field, then the projection) allocates nothing per step") {
+TEST_CASE("one-step rk4 and gauss with a constraint (the index-1 field, then the projection) allocate nothing per step, and implicit methods take quadratic constraints only") {
   FlatSpace space(3);
   FallingMass mass;
   UnitSphere sphere;
   HolonomicConstraints constraints({&sphere}, 3);
-  sdk::RungeKutta method = rk4();
-  OneStepHamiltonianMap map(space, mass, method, SolverOptions{}, &constraints);
   const Eigen::VectorXd q = (Eigen::VectorXd(3) << std::sin(1.0), 0.0, -std::cos(1.0)).finished();
   const Eigen::VectorXd p = (Eigen::VectorXd(3) << 0.0, 2.5, 0.0).finished();
-  CHECK(allocations_of_stepping(map, q, p, 0.01, 50) == 0);
+  for (sdk::RungeKutta method : {rk4(), gauss2()}) {
+    OneStepHamiltonianMap map(space, mass, method, SolverOptions{}, &constraints);
+    CHECK(allocations_of_stepping(map, q, p, 0.01, 50) == 0);
+  }
+  sphere.declared_quadratic = false;
+  HolonomicConstraints undeclared({&sphere}, 3);
+  sdk::RungeKutta explicit_method = rk4(), implicit_method = gauss2();
+  CHECK_NOTHROW(OneStepHamiltonianMap(space, mass, explicit_method, SolverOptions{}, &undeclared));
+  CHECK_THROWS_WITH_AS(OneStepHamiltonianMap(space, mass, implicit_method, SolverOptions{}, &undeclared),
+                       doctest::Contains("explicit Runge-Kutta methods only"), std::invalid_argument);
 }
 
 TEST_CASE("shooting rk4 + simpson with a constraint allocates nothing per step, and takes quadratic constraints only") {

@@ -24,7 +24,7 @@ class OneStep final : public Construction {
   std::shared_ptr<const MethodOptions> read(const json&) const override { return std::make_shared<MethodOptions>(); }
 
   // With constraints (docs/constraints.md): the index-1 equations and the projection after each step,
-  // for explicit Runge-Kutta methods (core/constrained_field.hpp).
+  // for explicit Runge-Kutta methods, and implicit ones with quadratic constraints (core/constrained_field.hpp).
   bool takes_constraints(ManifoldStructure structure) const override {
     return structure == ManifoldStructure::vector_space;
   }

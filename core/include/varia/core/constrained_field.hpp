@@ -13,8 +13,9 @@
 // jet follow exactly from their values at the jet's value, g(q + d) = g + G d + d^T H d / 2), at
 // second-order jets: there the projection's Newton iteration runs two iterations past the values'
 // convergence, which make the first and then the second derivatives exact. One template serves
-// both. The field has no Jacobian (its lambda's derivatives would need g's third derivatives): the
-// constructions take explicit Runge-Kutta methods only with constraints.
+// both. The field's Jacobian (an implicit method's stage Newton) is exact for quadratic constraints
+// only, where c's derivative in q vanishes (see jacobian()); otherwise it would need g's third
+// derivatives, and the constructions take explicit Runge-Kutta methods only.
 #pragma once
 
 #include <Eigen/Core>
@@ -34,10 +35,10 @@ class ConstrainedField final : public EulerLagrangeField {
   Status eval(const double* y, double* f) noexcept override;
   // Quadratic constraints only (else the Status says so).
   Status eval(const Jet2* y, Jet2* f) noexcept override;
-  Status jacobian(const double* /*y*/, double* /*f*/, double* /*df*/) noexcept override {
-    return "the constrained field (index 1) has no Jacobian: its multiplier's derivatives need the constraints' "
-           "third derivatives";
-  }
+  // Quadratic constraints only (else the Status says so).
+  Status jacobian(const double* y, double* f, double* df) noexcept override;
+  // Whether the field has its Jacobian (quadratic constraints): implicit methods may integrate it.
+  bool has_jacobian() const { return quadratic_; }
   // q onto g(q) = 0 (to `options.tolerance`, at most `options.max_iterations` Newton steps; throws
   // NumericalFailure otherwise), then v onto G(q) v = 0. At jets for quadratic constraints only.
   void project(double* q, double* v, const SolverOptions& options);
@@ -83,6 +84,10 @@ class ConstrainedField final : public EulerLagrangeField {
   Eigen::VectorXd point_, values_, unit_;  // a point's values, g there (at jets), e_i
   Eigen::PartialPivLU<Eigen::MatrixXd> lu_;
   JetLinearSolve jet_solve_;
+  // The Jacobian's workspace: L's Hessian, du/dz = M^-1 L_qz (n x 2n), R = d(S lambda)'s part (m x 2n),
+  // K = M^-1 H_lambda, r = W lambda, H_i d's products.
+  Eigen::MatrixXd lagrangian_hessian_, free_jacobian_, R_, K_, dense_hessian_;
+  Eigen::VectorXd weighted_, product_, scratch_;
 };
 
 }  // namespace varia

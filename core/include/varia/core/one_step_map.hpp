@@ -5,7 +5,7 @@
 // field is the MechanicalField; on a Lie group the Euler-Poincare field (lie_group_field.hpp),
 // y = (g, xi): Runge-Kutta methods integrate it in the embedding (R^9 x R^3 on SO(3)), Lie group
 // methods on the group (paper, sec. 2, Figure 1: RK, SRK, LGM). With holonomic constraints (on R^n,
-// a constant mass matrix, an explicit Runge-Kutta method) the method integrates their index-1
+// a constant mass matrix; an implicit method for quadratic constraints only) the method integrates their index-1
 // form and each step is projected onto the constraint and its hidden constraint
 // (constrained_field.hpp).
 #pragma once
@@ -29,8 +29,8 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
  public:
   // Throws std::invalid_argument unless the Lagrangian matches the manifold (a vector space or a
   // Lie group) and the field can be formed (lie_group_field.hpp, mechanical_field.hpp), and with
-  // constraints unless the manifold is a vector space and the method an explicit Runge-Kutta
-  // method (constrained_field.hpp).
+  // constraints unless the manifold is a vector space and the method explicit or the constraints
+  // quadratic (constrained_field.hpp).
   OneStepHamiltonianMap(Manifold& manifold, Lagrangian& lagrangian, OneStepMethod& method,
                         SolverOptions options, HolonomicConstraints* constraints = nullptr);
   int point_size() const override { return m_; }

@@ -55,8 +55,8 @@
 // quadratures there.
 //
 // With holonomic constraints g(q) = 0 on R^N (HolonomicConstraints, quadratic ones: docs/constraints.md)
-// the shot is the constrained one-step map (constrained_field.hpp): an explicit Runge-Kutta step of
-// the index-1 field, then the projection onto the constraint and its hidden constraint, at jets.
+// the shot is the constrained one-step map (constrained_field.hpp): a step of the method on the
+// index-1 field, then the projection onto the constraint and its hidden constraint, at jets.
 // L_d is then a function on Q x Q, Q = {g = 0} of dimension n = N - m, and the construction runs in
 // charts of Q: x = (a, w0) in R^2n with q^0, v^0 the projections of q0 + N0 a and N0 w0 (N0 an
 // orthonormal basis of T_q0 Q), and B = N1^T (q^n - c) (N1 one of T_c Q, c = q1 or, in a step,
@@ -64,7 +64,7 @@
 // read as N0^T p0, and p1 = N1 lambda is taken onto the cotangent space as the projection's M v
 // with G(q1) v = 0 (the momenta the Galerkin construction holds). Its theorem is the
 // unconstrained one on Q: order min(p, q) for the projected method's order p, symplectic on Q.
-// The lagrangian form only, no forces, a constant mass matrix, explicit methods, no tangent map.
+// The lagrangian form only, no forces, a constant mass matrix, no tangent map.
 //
 // Sensitivities in passes: a jet holds at most kMaxJetVariables = 12 variables, or fewer where the
 // field's derivatives at jets take fewer (MechanicalField::jet_variables). Where 2n exceeds that
@@ -116,8 +116,8 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // manifold, Lagrangian or quadrature, or forces with the type_2 form or an end-derivative rule.
   // jet_capacity: the most variables of a pass's jets (at most kMaxJetVariables; fewer: more
   // passes of smaller jets, the same derivatives). constraints: holonomic constraints on the
-  // vector space (quadratic ones; throws std::invalid_argument otherwise, or for another form,
-  // forces or an implicit method with them).
+  // vector space (quadratic ones; throws std::invalid_argument otherwise, or for another form or
+  // forces with them).
   ShootingDiscreteLagrangian(Manifold& manifold, Lagrangian& lagrangian, Quadrature& quadrature,
                              OneStepMethod& method, ShootingForm form, SolverOptions options,
                              std::vector<Force*> forces = {}, int jet_capacity = kMaxJetVariables,
