@@ -106,6 +106,23 @@ double HolonomicConstraints::velocity_residual(const double* q, const double* v)
   return m_ == 0 ? 0.0 : g_.lpNorm<Eigen::Infinity>();
 }
 
+TangentBasis::TangentBasis(HolonomicConstraints& constraints)
+    : constraints_(constraints),
+      normals_(constraints.dim(), constraints.size()),
+      basis_(constraints.dim(), constraints.dim() - constraints.size()),
+      qr_(constraints.dim(), constraints.size()),
+      workspace_(constraints.dim()) {}
+
+const Eigen::MatrixXd& TangentBasis::at(const double* q) {
+  constraints_.evaluate_jacobian(q);
+  normals_ = constraints_.jacobian().transpose();
+  qr_.compute(normals_);
+  basis_.setZero();
+  basis_.bottomRows(basis_.cols()).setIdentity();
+  qr_.householderQ().applyThisOnTheLeft(basis_, workspace_);
+  return basis_;
+}
+
 struct FixedPatternMatrix::Factorization {
   Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
 };

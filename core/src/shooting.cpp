@@ -177,9 +177,7 @@ void ShootingDiscreteLagrangian::size_workspace() {
   if (constrained_ == nullptr) return;
   start_basis_.resize(m_, n_);
   end_basis_.resize(m_, n_);
-  normals_.resize(m_, m_ - n_);
-  basis_qr_ = Eigen::HouseholderQR<Eigen::MatrixXd>(m_, m_ - n_);
-  basis_workspace_.resize(m_);
+  tangent_basis_ = std::make_unique<TangentBasis>(*constraints_);
   chart_momentum_.resize(n_);
   velocity_.resize(m_);
   embedded_momentum_.resize(m_);
@@ -394,7 +392,7 @@ void ShootingDiscreteLagrangian::boundary() {
   if (target_is_end_ && mechanical_ == nullptr)
     for (int r = 0; r < m_; ++r) target_[r] = state_[r].value;
   if (constrained_ != nullptr) {  // B = N1^T (q^n - c), c the target
-    tangent_basis(target_.data(), end_basis_);
+    end_basis_ = tangent_basis_->at(target_.data());
     for (int r = 0; r < n_; ++r) {
       Jet2& b = boundary_[r] = seeded(0.0, -1);
       for (int k = 0; k < m_; ++k) {
@@ -473,16 +471,6 @@ void ShootingDiscreteLagrangian::take_step(const double* q0, const double* p0, d
   forced_ = !forces_.empty();
   t_ = t0;
   (this->*step_)(q0, p0, h, q1, p1);
-}
-
-// The last columns of G(q)^T's Householder QR: an orthonormal basis of G(q)'s null space, T_q Q.
-void ShootingDiscreteLagrangian::tangent_basis(const double* q, Eigen::MatrixXd& basis) {
-  constraints_->evaluate_jacobian(q);
-  normals_ = constraints_->jacobian().transpose();
-  basis_qr_.compute(normals_);
-  basis.setZero();
-  basis.bottomRows(n_).setIdentity();
-  basis_qr_.householderQ().applyThisOnTheLeft(basis, basis_workspace_);
 }
 
 const EvaluationCounters& ShootingDiscreteLagrangian::evaluations() const {

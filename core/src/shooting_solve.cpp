@@ -213,7 +213,7 @@ void ShootingDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
 // p1 = N1 lambda taken onto the cotangent space. No warm start: the bases change from step to step.
 void ShootingDiscreteLagrangian::step_on_constraint(const double* q0, const double* p0, double h, double* q1,
                                                     double* p1) {
-  tangent_basis(q0, start_basis_);
+  start_basis_ = tangent_basis_->at(q0);
   const Eigen::Map<const Eigen::VectorXd> momentum(p0, m_);
   chart_momentum_.noalias() = start_basis_.transpose() * momentum;
   velocity_.noalias() = field_->inverse_mass() * momentum;
@@ -267,7 +267,7 @@ void ShootingDiscreteLagrangian::evaluate(const double* q0, const double* q1, do
   target_is_end_ = false;
   std::copy_n(q1, m_, target_.begin());
   if (constrained_ != nullptr) {
-    tangent_basis(q0, start_basis_);
+    start_basis_ = tangent_basis_->at(q0);
     velocity_ = (Eigen::Map<const Eigen::VectorXd>(q1, m_) - Eigen::Map<const Eigen::VectorXd>(q0, m_)) / h;
     w_.noalias() = start_basis_.transpose() * velocity_;
     solve<Eigen::Dynamic>(q0, h, Target::boundary, zero_.data());

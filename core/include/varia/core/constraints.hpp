@@ -13,6 +13,7 @@
 #pragma once
 
 #include <Eigen/Core>
+#include <Eigen/QR>
 #include <Eigen/SparseCore>
 #include <memory>
 #include <vector>
@@ -53,6 +54,21 @@ class HolonomicConstraints {
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian_;
   Eigen::SparseMatrix<double> hessian_;
   Eigen::VectorXd g_;
+};
+
+// An orthonormal basis of ker G(q), the tangent space at q of the constraint manifold (n x (n - m)
+// numbers): the last columns of the Householder QR of G(q)^T. Sized once: at() allocates nothing.
+class TangentBasis {
+ public:
+  explicit TangentBasis(HolonomicConstraints& constraints);
+  // Evaluates G(q); the basis stays valid until the next call.
+  const Eigen::MatrixXd& at(const double* q);
+
+ private:
+  HolonomicConstraints& constraints_;
+  Eigen::MatrixXd normals_, basis_;  // G^T, the basis
+  Eigen::HouseholderQR<Eigen::MatrixXd> qr_;
+  Eigen::VectorXd workspace_;
 };
 
 // A square sparse matrix of a fixed pattern: entries are named (slot) while it is being set up,

@@ -86,7 +86,6 @@
 
 #include <Eigen/Core>
 #include <Eigen/LU>
-#include <Eigen/QR>
 #include <memory>
 #include <string>
 #include <vector>
@@ -175,8 +174,6 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   Jet2 seeded(double value, int variable) const;
   void start_point(const double* q0, const double* w0);
   void boundary();
-  // With constraints: an orthonormal basis of T_q Q (N x n) into `basis`.
-  void tangent_basis(const double* q, Eigen::MatrixXd& basis);
   // The step with constraints (step_ there): in the charts of Q at q0 and q1 (see above).
   void step_on_constraint(const double* q0, const double* p0, double h, double* q1, double* p1);
   // The members templated on N do the shooting Newton's algebra on vectors of N = n numbers and
@@ -274,11 +271,11 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // directions' right-hand sides and dw0 (n x count).
   Eigen::MatrixXd tangent_lambda_, tangent_d1_, tangent_rhs_, tangent_w_;
   Eigen::PartialPivLU<Eigen::MatrixXd> tangent_bw_lu_, tangent_lu_;
-  // With constraints: the charts' bases N0, N1 (N x n), G^T and its QR (the bases' source), the
-  // momentum p0 on T_q0 Q (n numbers), a velocity and a momentum in R^N.
-  Eigen::MatrixXd start_basis_, end_basis_, normals_;
-  Eigen::HouseholderQR<Eigen::MatrixXd> basis_qr_;
-  Eigen::VectorXd basis_workspace_, chart_momentum_, velocity_, embedded_momentum_;
+  // With constraints: the charts' bases N0, N1 (N x n) and their source, the momentum p0 on T_q0 Q
+  // (n numbers), a velocity and a momentum in R^N.
+  Eigen::MatrixXd start_basis_, end_basis_;
+  std::unique_ptr<TangentBasis> tangent_basis_;
+  Eigen::VectorXd chart_momentum_, velocity_, embedded_momentum_;
 };
 
 }  // namespace varia
