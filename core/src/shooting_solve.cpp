@@ -132,14 +132,11 @@ struct ShootingDiscreteLagrangian::Equations {
   // The step's outcome at the updated w0, to first order from the last shot (no propagation):
   // the state's values by their w0-derivatives, lambda by dlambda/dw0 = B_w^{-T} Phi_ww, the
   // momentum change by dD1/dw0 + dlambda/dw0, the residual by its Jacobian.
-  // On a Lie group and with constraints the point is the state's (one pass, whose variables are
-  // x = (eta, w0)); on a vector space it is read from B.
+  // The point is read from B (step_at, step_on_constraint), whose w0-derivatives every pass plan
+  // gives.
   void finish(const Eigen::VectorXd& update_vector) {
     if (target != Target::momentum) return;
     const Eigen::Map<const Vector<N>> update(update_vector.data(), n);
-    if (s.mechanical_ == nullptr)
-      for (int r = 0; r < s.m_; ++r)
-        if (!s.state_[r].constant()) s.state_[r].value -= s.state_[r].gradient.tail(n).dot(update);
     const Eigen::Map<const Square<N>> Bw(s.Bw_.data(), n, n), jacobian(s.jacobian_.data(), n, n),
         lambda_jacobian(s.lambda_jacobian_.data(), n, n);
     for (int r = 0; r < n; ++r) s.boundary_[r].value -= Bw.row(r).dot(update);
@@ -199,8 +196,9 @@ void ShootingDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
     }
     Eigen::Map<Vector<N>>(q1, n) = end_q;
     p = end_p;
-  } else {
-    for (int r = 0; r < m; ++r) q1[r] = state_[r].value;
+  } else {  // a Lie group: q1 = c exp(B), c = q^n's value at the last shot
+    for (int r = 0; r < n; ++r) v_values_[r] = boundary_[r].value;
+    check(manifold_, manifold_.retract(target_.data(), v_values_.data(), q1), "manifold retract");
     p = Eigen::Map<const Vector<N>>(lambda_.data(), n);  // with forces p1 = D2 L_d + f_d^+
     end_q = Eigen::Map<const Vector<N>>(q1, m);
     end_p = p;
@@ -220,7 +218,10 @@ void ShootingDiscreteLagrangian::step_on_constraint(const double* q0, const doub
   w_.noalias() = start_basis_.transpose() * velocity_;
   target_is_end_ = true;
   solve<Eigen::Dynamic>(q0, h, Target::momentum, chart_momentum_.data());
-  for (int r = 0; r < m_; ++r) q1[r] = state_[r].value;
+  // q1 = c + N1 B, c = q^n's value at the last shot (on Q to O(|B|^2), B the last update's size).
+  for (int r = 0; r < n_; ++r) v_values_[r] = boundary_[r].value;
+  Eigen::Map<Eigen::VectorXd>(q1, m_) = Eigen::Map<const Eigen::VectorXd>(target_.data(), m_);
+  Eigen::Map<Eigen::VectorXd>(q1, m_).noalias() += end_basis_ * v_values_;
   embedded_momentum_.noalias() = end_basis_ * lambda_;
   velocity_.noalias() = field_->inverse_mass() * embedded_momentum_;
   constrained_->project_velocity(q1, velocity_.data());

@@ -326,6 +326,41 @@ TEST_CASE("on S2 x S2 a momentum is read and written orthogonal to the normals, 
   CHECK_THROWS_WITH_AS(assembled(across, registry, scene), doctest::Contains("/initial/p"), InputError);
 }
 
+// Four particles on a chain of rods: n = 12 - 4 = 8 dimensions, 16 jet variables, more than a jet
+// holds, so the shot's sensitivities come in passes (docs/shooting.md). Against Galerkin degree 4
+// at h/4 (order 8) as the reference.
+TEST_CASE("shooting with constraints in passes: a chain of four rods under rk4 + simpson agrees with a galerkin reference") {
+  Registry registry{Registry::search_path({})};
+  json document = json::parse(test::read_file(test::kSourceDir / "scenes/multibody/double-spherical-pendulum-rod.json"));
+  const int particles = 4;
+  document["system"]["manifold"]["dim"] = 3 * particles;
+  document["system"]["lagrangian"]["masses"] = std::vector<double>(particles, 1.0);
+  json rods = json::array({{{"type", "rod"}, {"anchor", {0, 0, 0}}, {"particle", 0}, {"length", 1}}});
+  for (int i = 0; i + 1 < particles; ++i) rods.push_back({{"type", "rod"}, {"between", {i, i + 1}}, {"length", 1}});
+  document["system"]["constraints"] = rods;
+  std::vector<double> q, v;
+  for (int i = 1; i <= particles; ++i) {
+    q.insert(q.end(), {i * std::sin(0.6), 0.0, -i * std::cos(0.6)});
+    v.insert(v.end(), {0.0, 0.5 * i, 0.0});
+  }
+  document["initial"] = {{"q", q}, {"v", v}};
+  document.erase("t_end");
+  const auto final_q = [&](const json& method, double h, long steps) {
+    json d = document;
+    d["method"] = method;
+    d["step"] = h;
+    d["steps"] = steps;
+    return record_of(d, registry)["final"]["q"].get<std::vector<double>>();
+  };
+  const std::vector<double> shot = final_q(constrained_shooting("rk4", "simpson"), 0.01, 100);
+  json reference_method = galerkin_lobatto(4);
+  const std::vector<double> reference = final_q(reference_method, 0.0025, 400);
+  double error = 0.0;
+  for (std::size_t k = 0; k < shot.size(); ++k) error = std::max(error, std::abs(shot[k] - reference[k]));
+  MESSAGE("chain of four rods, shooting rk4 + simpson at h = 0.01, T = 1: max |q - q_ref| = ", error);
+  CHECK(error <= 1e-7);
+}
+
 TEST_CASE("S2 is refused where it cannot be served, and a point off the sphere at /initial/q") {
   Registry registry{Registry::search_path({})};
   Scene scene;
