@@ -15,6 +15,32 @@ void set_zero(T& r) {
   r = T(0.0);
 }
 
+// The loops over G^T (n x m) and W (n x m) of the field, the projections and their jets.
+// S = A^T B (m x m).
+template <class Matrix>
+void cross_product(const Matrix& A, const Matrix& B, Matrix& S) {
+  for (Eigen::Index i = 0; i < S.rows(); ++i)
+    for (Eigen::Index l = 0; l < S.cols(); ++l) {
+      auto& s = S(i, l);
+      set_zero(s);
+      for (Eigen::Index j = 0; j < A.rows(); ++j) s += A(j, i) * B(j, l);
+    }
+}
+
+// out += A^T x (m numbers).
+template <class Matrix, class T, class Vector>
+void add_transposed_product(const Matrix& A, const T* x, Vector& out) {
+  for (Eigen::Index i = 0; i < A.cols(); ++i)
+    for (Eigen::Index j = 0; j < A.rows(); ++j) out[i] += A(j, i) * x[j];
+}
+
+// x -= A y (n numbers).
+template <class Matrix, class Vector, class T>
+void subtract_product(const Matrix& A, const Vector& y, T* x) {
+  for (Eigen::Index j = 0; j < A.rows(); ++j)
+    for (Eigen::Index i = 0; i < A.cols(); ++i) x[j] -= A(j, i) * y[i];
+}
+
 }  // namespace
 
 ConstrainedField::ConstrainedField(LagrangianEvaluator& lagrangian, HolonomicConstraints& constraints)
@@ -31,7 +57,6 @@ ConstrainedField::ConstrainedField(LagrangianEvaluator& lagrangian, HolonomicCon
       free_jacobian_(n_, 2 * n_),
       R_(m_, 2 * n_),
       K_(n_, n_),
-      dense_hessian_(n_, n_),
       weighted_(n_),
       product_(n_),
       scratch_(n_) {
@@ -116,12 +141,7 @@ void ConstrainedField::factor(Workspace<T>& w) {
       for (int k = 0; k < n_; ++k)
         if (inverse_mass_(j, k) != 0.0) add_scaled(x, inverse_mass_(j, k), w.GT(k, i));
     }
-  for (int i = 0; i < m_; ++i)
-    for (int l = 0; l < m_; ++l) {
-      T& s = w.S(i, l);
-      set_zero(s);
-      for (int j = 0; j < n_; ++j) s += w.GT(j, i) * w.W(j, l);
-    }
+  cross_product(w.GT, w.W, w.S);
 }
 
 template <class T>
@@ -149,16 +169,12 @@ Status ConstrainedField::evaluate(const T* y, T* f) noexcept {
     inverse_mass(w.gradient.data(), w.free.data());
     linearize(y, v, w);
     factor(w);
-    for (int i = 0; i < m_; ++i) {
-      w.rhs[i] = w.curvature[i];
-      for (int j = 0; j < n_; ++j) w.rhs[i] += w.GT(j, i) * w.free[j];
-    }
+    w.rhs = w.curvature;
+    add_transposed_product(w.GT, w.free.data(), w.rhs);
     solve<T>(w.S, w.rhs, w.multiplier);
     T* a = f + n_;
-    for (int j = 0; j < n_; ++j) {
-      a[j] = w.free[j];
-      for (int i = 0; i < m_; ++i) a[j] -= w.W(j, i) * w.multiplier[i];
-    }
+    std::copy_n(w.free.data(), n_, a);
+    subtract_product(w.W, w.multiplier, a);
   });
 }
 
@@ -195,16 +211,14 @@ Status ConstrainedField::jacobian(const double* y, double* f, double* df) noexce
       R_.row(i).tail(n_) += 2.0 * scratch_.transpose();
     }
     constraints_.evaluate_hessian(y, w.multiplier.data());
-    dense_hessian_ = constraints_.hessian();
-    K_.noalias() = inverse_mass_ * dense_hessian_;
+    K_.noalias() = inverse_mass_ * constraints_.hessian();
     R_.leftCols(n_).noalias() -= w.GT.transpose() * K_;
     Eigen::Map<Eigen::MatrixXd> J(df, 2 * n_, 2 * n_);
     J.setZero();
     J.topRightCorner(n_, n_).setIdentity();
     J.bottomRows(n_) = free_jacobian_;
     J.bottomLeftCorner(n_, n_) -= K_;
-    lu_.compute(w.S);
-    for (int c = 0; c < 2 * n_; ++c) {
+    for (int c = 0; c < 2 * n_; ++c) {  // lu_ holds S's factors from evaluate()
       w.rhs = lu_.solve(R_.col(c));
       J.col(c).tail(n_).noalias() -= w.W * w.rhs;
     }
@@ -228,18 +242,11 @@ void ConstrainedField::project_point(T* q, const SolverOptions& options) {
     if (residual <= options.tolerance && exact-- == 0) return;
     if (iteration == options.max_iterations)
       throw NumericalFailure("the projection onto the constraint did not converge", residual);
-    for (int i = 0; i < m_; ++i)
-      for (int l = 0; l < m_; ++l) {
-        T& s = w.S(i, l);
-        set_zero(s);
-        for (int j = 0; j < n_; ++j) s += w.GT(j, i) * w.W_start(j, l);
-      }
+    cross_product(w.GT, w.W_start, w.S);
     solve<T>(w.S, w.g, w.step);
     w.multiplier += w.step;
-    for (int j = 0; j < n_; ++j) {
-      q[j] = w.start[j];
-      for (int i = 0; i < m_; ++i) q[j] -= w.W_start(j, i) * w.multiplier[i];
-    }
+    std::copy_n(w.start.data(), n_, q);
+    subtract_product(w.W_start, w.multiplier, q);
     linearize(q, static_cast<const T*>(nullptr), w);
   }
 }
@@ -248,13 +255,10 @@ void ConstrainedField::project_point(T* q, const SolverOptions& options) {
 template <class T>
 void ConstrainedField::project_onto_hidden(T* v, Workspace<T>& w) {
   factor(w);
-  for (int i = 0; i < m_; ++i) {
-    set_zero(w.rhs[i]);
-    for (int j = 0; j < n_; ++j) w.rhs[i] += w.GT(j, i) * v[j];
-  }
+  for (int i = 0; i < m_; ++i) set_zero(w.rhs[i]);
+  add_transposed_product(w.GT, v, w.rhs);
   solve<T>(w.S, w.rhs, w.multiplier);
-  for (int j = 0; j < n_; ++j)
-    for (int i = 0; i < m_; ++i) v[j] -= w.W(j, i) * w.multiplier[i];
+  subtract_product(w.W, w.multiplier, v);
 }
 
 void ConstrainedField::project(double* q, double* v, const SolverOptions& options) {

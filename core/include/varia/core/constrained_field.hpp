@@ -86,7 +86,7 @@ class ConstrainedField final : public EulerLagrangeField {
   JetLinearSolve jet_solve_;
   // The Jacobian's workspace: L's Hessian, du/dz = M^-1 L_qz (n x 2n), R = d(S lambda)'s part (m x 2n),
   // K = M^-1 H_lambda, r = W lambda, H_i d's products.
-  Eigen::MatrixXd lagrangian_hessian_, free_jacobian_, R_, K_, dense_hessian_;
+  Eigen::MatrixXd lagrangian_hessian_, free_jacobian_, R_, K_;
   Eigen::VectorXd weighted_, product_, scratch_;
 };
 
