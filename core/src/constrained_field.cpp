@@ -61,7 +61,7 @@ ConstrainedField::ConstrainedField(LagrangianEvaluator& lagrangian, HolonomicCon
       product_(n_),
       scratch_(n_) {
   if (!constant_mass_)
-    throw std::invalid_argument("constraints need a Lagrangian with a constant mass matrix");
+    throw ConstraintsRefused("constraints need a Lagrangian with a constant mass matrix");
   const auto size = [&](auto& w) {
     for (auto* v : {&w.g, &w.curvature, &w.rhs, &w.multiplier, &w.step}) v->resize(m_);
     for (auto* v : {&w.gradient}) v->resize(2 * n_);
@@ -84,7 +84,7 @@ ConstrainedField::Workspace<Jet2>& ConstrainedField::workspace<Jet2>() {
 
 void ConstrainedField::require_quadratic() const {
   if (!quadratic_)
-    throw std::invalid_argument("the constrained field at jets takes quadratic constraints only (Constraint::quadratic: "
+    throw ConstraintsRefused("the constrained field at jets takes quadratic constraints only (Constraint::quadratic: "
                                 "a constant Hessian); others would need g's third and fourth derivatives");
 }
 

@@ -13,11 +13,11 @@ std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvalu
                                              const OneStepMethod& method, HolonomicConstraints* constraints) {
   if (constraints != nullptr) {
     if (!manifold.is_vector_space())
-      throw std::invalid_argument("with constraints the one-step construction takes vector spaces only");
+      throw ConstraintsRefused("with constraints the one-step construction takes vector spaces only");
     require_vector_space(manifold, lagrangian.plugin(), "the one-step construction");
     auto field = std::make_unique<ConstrainedField>(lagrangian, *constraints);
     if (method.explicit_tableau().stages == 0 && !field->has_jacobian())
-      throw std::invalid_argument(
+      throw ConstraintsRefused(
           "with constraints that are not quadratic the one-step construction takes explicit Runge-Kutta methods only "
           "(an implicit method's stages need the constrained field's Jacobian, whose multiplier's derivatives need "
           "the constraints' third derivatives)");

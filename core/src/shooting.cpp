@@ -35,9 +35,9 @@ std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvalu
                                             ShootingForm form, Forces& forces, HolonomicConstraints* constraints) {
   if (constraints != nullptr) {
     if (form != ShootingForm::lagrangian || !forces.empty())
-      throw std::invalid_argument("with constraints the shooting construction takes the lagrangian form and no forces");
+      throw ConstraintsRefused("with constraints the shooting construction takes the lagrangian form and no forces");
     if (!constraints->quadratic())
-      throw std::invalid_argument(
+      throw ConstraintsRefused(
           "with constraints the shooting construction takes quadratic constraints only (Constraint::quadratic, as "
           "rod and S2's): its shot carries the constrained field at second-order jets, which would need the "
           "constraints' third and fourth derivatives");

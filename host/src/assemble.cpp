@@ -12,6 +12,10 @@
 
 namespace varia::host {
 
+std::string constraints_pointer(const Scene& scene) {
+  return scene.constraints.empty() ? "/system/manifold" : "/system/constraints";
+}
+
 namespace {
 
 // Spec "Composed systems": forces enter through the discrete Lagrange-d'Alembert principle, which
@@ -41,7 +45,7 @@ bool has_constant_mass_matrix(Lagrangian& lagrangian) {
 // /system/constraints (at /system/manifold for the manifold's equations).
 void create_constraints(const Scene& scene, Registry& registry, Assembly& a) {
   if (scene.constraints.empty() && !a.embedded) return;
-  const std::string pointer = scene.constraints.empty() ? "/system/manifold" : "/system/constraints";
+  const std::string pointer = constraints_pointer(scene);
   const std::string what = scene.constraints.empty()
                                ? fmt::format("the {} manifold is served in its embedding, with its equations' "
                                              "multipliers, as constraints are",

@@ -55,6 +55,11 @@ const Eigen::VectorXd& written_momentum(Assembly& a, const Eigen::VectorXd& q, c
 // `verify` and `cost` measure against it; otherwise against a reference run of the same system.
 bool has_exact_solution(const Assembly& assembly);
 
+// Where a refusal of the system's constraints points (spec "Constrained systems"): at
+// /system/constraints, or at /system/manifold where the only ones are an embedded manifold's own
+// equations (S2).
+std::string constraints_pointer(const Scene& scene);
+
 // A Lagrangian's momentum map has at most dim (dim + 2) numbers, the dimension of the largest Lie
 // group that acts effectively on a manifold of dimension dim (the projective group on RP^dim): a
 // plugin declaring more is at fault (PluginFault from the Lagrangian, naming its plugin), rather

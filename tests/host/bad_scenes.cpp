@@ -78,7 +78,7 @@ const std::map<std::string, std::string> kBadScenes{
     // constraints (docs/constraints.md): a start off them, a construction that does not take them, a
     // rod to a particle the system lacks
     {"rod-start-off-constraint.json", "/initial/q: expected a point on the constraints (max |g_i(q)| <= 1e-10); found max |g_i(q)| = 0.001"},
-    {"rod-under-hamiltonian-shooting.json", "/method: with constraints the shooting construction takes the lagrangian form and no forces"},
+    {"rod-under-hamiltonian-shooting.json", "/system/constraints: with constraints the shooting construction takes the lagrangian form and no forces"},
     {"rod-missing-particle.json", "/system/constraints/0: particle 1 does not exist (the system has 1)"},
     {"rigid-body-chain-wrong-manifold.json", "/system/lagrangian: rigid-body-chain: 3 bodies need the manifold product(SO3,SO3,SO3)"},
     {"reduced-heavy-top.json", "/method/reduced: the reduced (Euler-Poincare) form needs a Lagrangian invariant under the whole group"},

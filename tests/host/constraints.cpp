@@ -367,8 +367,8 @@ TEST_CASE("S2 is refused where it cannot be served, and a point off the sphere a
   json hamiltonian = scene_file("spherical-pendulum-s2.json");
   hamiltonian["method"] = constrained_shooting("rk4", "simpson");
   hamiltonian["method"]["form"] = "hamiltonian";
-  CHECK_THROWS_WITH_AS(assembled(hamiltonian, registry, scene), doctest::Contains("/method: with constraints"),
-                       InputError);
+  CHECK_THROWS_WITH_AS(assembled(hamiltonian, registry, scene),
+                       doctest::Contains("/system/manifold: with constraints"), InputError);
   json off = scene_file("spherical-pendulum-s2.json");
   off["initial"]["q"] = {0.85, 0, -0.54};
   CHECK_THROWS_WITH_AS(assembled(off, registry, scene), doctest::Contains("/initial/q"), InputError);
@@ -383,8 +383,8 @@ TEST_CASE("constraints are refused where they cannot be served, and a start off 
   json hamiltonian = spherical_pendulum(1, 0.01, 10);
   hamiltonian["method"] = constrained_shooting("rk4", "simpson");
   hamiltonian["method"]["form"] = "hamiltonian";
-  CHECK_THROWS_WITH_AS(assembled(hamiltonian, registry, scene), doctest::Contains("/method: with constraints"),
-                       InputError);
+  CHECK_THROWS_WITH_AS(assembled(hamiltonian, registry, scene),
+                       doctest::Contains("/system/constraints: with constraints"), InputError);
   json off = spherical_pendulum(1, 0.01, 10);
   off["initial"]["q"] = {0.85, 0, -0.54};
   CHECK_THROWS_WITH_AS(assembled(off, registry, scene), doctest::Contains("/initial/q"), InputError);

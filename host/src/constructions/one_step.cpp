@@ -34,6 +34,8 @@ class OneStep final : public Construction {
     try {
       a.map = std::make_unique<OneStepHamiltonianMap>(*a.manifold, *a.lagrangian, *a.one_step, scene.solver,
                                                       a.holonomic.get());
+    } catch (const ConstraintsRefused& e) {
+      throw InputError(constraints_pointer(scene) + ": " + e.what());
     } catch (const std::invalid_argument& e) {
       if (!a.holonomic) throw;
       throw InputError(std::string("/method/one_step: ") + e.what());

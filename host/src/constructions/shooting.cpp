@@ -55,6 +55,8 @@ class Shooting final : public Construction {
                                                               a.holonomic.get());
       a.discrete_lagrangian = map.get();
       a.map = std::move(map);
+    } catch (const ConstraintsRefused& e) {
+      throw InputError(fmt::format("{}: {}", constraints_pointer(scene), e.what()));
     } catch (const std::invalid_argument& e) {
       throw InputError(fmt::format("/method: {}", e.what()));
     }

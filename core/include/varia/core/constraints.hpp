@@ -16,11 +16,18 @@
 #include <Eigen/QR>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <stdexcept>
 #include <vector>
 
 #include "varia/abi/constraint.hpp"
 
 namespace varia {
+
+// A construction's refusal of the system's constraints with the rest of what the scene chose (a
+// method, a form, forces): the host reports it at the constraints (spec: /system/constraints).
+struct ConstraintsRefused : std::invalid_argument {
+  using std::invalid_argument::invalid_argument;
+};
 
 class HolonomicConstraints {
  public:
