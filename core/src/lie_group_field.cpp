@@ -39,6 +39,7 @@ LieGroupField::LieGroupField(Manifold& manifold, LagrangianEvaluator& lagrangian
       torque_(n_),
       group_velocity_(m_),
       group_velocity_jet_(m_),
+      velocity_hessian_jet_(0, 0),
       inertia_solve_(0) {
   if (constant_mass_) return;
   hessian_jet_variables_ = lagrangian.plugin().hessian_jet_variables();
@@ -49,7 +50,7 @@ LieGroupField::LieGroupField(Manifold& manifold, LagrangianEvaluator& lagrangian
         "Euler-Poincare equations with an inertia that depends on the point); this one gives neither");
   const int k = m_ + n_;
   hessian_.resize(k, k);
-  hessian_jet_.resize(static_cast<std::size_t>(k) * k);
+  velocity_hessian_jet_ = VelocityHessianJet(m_, n_);
   inertia_solve_ = JetLinearSolve(n_);
 }
 
@@ -104,7 +105,12 @@ void LieGroupField::prepare(const Jet2* y) {
   }
   check(manifold_, manifold_.generators(y, generators_jet_.data()), "manifold generators");
   lagrangian_.gradient_jet(y, y + m_, nullptr, gradient_jet_.data());
-  if (!constant_mass_) lagrangian_.hessian_jet(y, y + m_, hessian_jet_.data());
+  if (constant_mass_) return;
+  for (int k = 0; k < m_; ++k) {  // g' = D xi, the direction of L_xig g'
+    Jet2& sum = group_velocity_jet_[k] = Jet2(0.0);
+    for (int a = 0; a < n_; ++a) sum += generators_jet_[k * n_ + a] * y[m_ + a];
+  }
+  velocity_hessian_jet_.evaluate(lagrangian_, y, y + m_, group_velocity_jet_.data());
 }
 
 // g' = D xi;  L_xixi xi' = ad*_xi mu + D^T dL/dg - L_xig g', with (ad*_xi mu)_b =
@@ -149,13 +155,12 @@ void LieGroupField::rates(const T* y, const T* D, const T* gradient, T* velocity
         const double C = structure_[(c * n_ + a) * n_ + b];
         if (C != 0.0) sum += C * (mu[c] * xi[a]);
       }
-    if (!constant_mass_)
-      for (int k = 0; k < m_; ++k) {
-        if constexpr (std::is_same_v<T, double>)
-          sum -= mixed(b, k) * group_velocity[k];
-        else
-          sum -= mixed_jet(b, k) * group_velocity[k];
-      }
+    if (!constant_mass_) {
+      if constexpr (std::is_same_v<T, double>)
+        for (int k = 0; k < m_; ++k) sum -= mixed(b, k) * group_velocity[k];
+      else
+        sum -= velocity_hessian_jet_.along(b);
+    }
     torque[b] = sum;
   }
   solve_inertia(torque, rate);
@@ -167,11 +172,10 @@ void LieGroupField::solve_inertia(const double* torque, double* rate) {
   Eigen::Map<Eigen::VectorXd>(rate, n_) = inertia_lu_.solve(Eigen::Map<const Eigen::VectorXd>(torque, n_));
 }
 
-// At jets: L_xixi's block of L's Hessian at jets (JetLinearSolve).
+// At jets: L_xixi from the velocity rows of L's Hessian at jets (JetLinearSolve).
 void LieGroupField::solve_inertia(const Jet2* torque, Jet2* rate) {
   if (constant_mass_) return inverse_mass(torque, rate);
-  const int k = m_ + n_;
-  inertia_solve_.solve(hessian_jet_.data() + m_ * k + m_, k, torque, rate);
+  inertia_solve_.solve(velocity_hessian_jet_.inertia(), n_, torque, rate);
 }
 
 Status LieGroupField::eval(const double* y, double* f) noexcept {

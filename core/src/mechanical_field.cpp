@@ -48,7 +48,7 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
       v_jet_(n_),
       gradient_jet_(2 * n_),
       legendre_residual_(2 * n_),
-      hessian_jet_(general_tangent() ? 4 * n_ * n_ : 0),  // only the general tangent form takes L's Hessian at jets
+      velocity_hessian_jet_(general_tangent() ? n_ : 0, general_tangent() ? n_ : 0),  // the general tangent form's
       seed_(2 * n_),
       acceleration_jet_(n_),
       correction_jet_(n_),
@@ -63,6 +63,19 @@ MechanicalField::MechanicalField(LagrangianEvaluator& lagrangian, PhaseSpace spa
         "it at every size; sdk::TermwiseLagrangian and hand-written ones may not, docs/shooting.md). "
         "Integrate in (q, p): the shooting construction's \"form\": \"hamiltonian\"");
   v_.setZero();
+}
+
+VelocityHessianJet::VelocityHessianJet(int m, int n)
+    : m_(m),
+      n_(n),
+      directions_(static_cast<std::size_t>(n + 1) * (m + n), Jet2(0.0)),
+      out_(static_cast<std::size_t>(n) * (n + 1)) {
+  for (int j = 0; j < n; ++j) directions_[static_cast<std::size_t>(j) * (m + n) + m + j] = Jet2(1.0);
+}
+
+void VelocityHessianJet::evaluate(LagrangianEvaluator& lagrangian, const Jet2* q, const Jet2* v, const Jet2* u) {
+  std::copy(u, u + m_, directions_.begin() + static_cast<std::ptrdiff_t>(n_) * (m_ + n_));
+  lagrangian.hessian_jet(q, v, m_, n_, n_ + 1, directions_.data(), out_.data());
 }
 
 int MechanicalField::jet_variables() const {
@@ -282,17 +295,13 @@ void MechanicalField::acceleration(double* a) {
   Eigen::Map<Eigen::VectorXd>(a, n_) = mass_lu_.solve(rhs_);
 }
 
-// a = M^{-1} (L_q + f - L_vq v) at jets (L_q + f in gradient_jet_), M = L_vv: L's Hessian at jets
-// gives M and L_vq, and the solve at jets starts from M's values (JetLinearSolve, as in velocity()).
+// a = M^{-1} (L_q + f - L_vq v) at jets (L_q + f in gradient_jet_), M = L_vv: the velocity rows of
+// L's Hessian at jets give M and L_vq v, and the solve at jets starts from M's values
+// (JetLinearSolve, as in velocity()).
 void MechanicalField::acceleration(const Jet2* q, const Jet2* v, Jet2* a) {
-  lagrangian_.hessian_jet(q, v, hessian_jet_.data());
-  const int k = 2 * n_;
-  const auto H = [&](int r, int c) -> const Jet2& { return hessian_jet_[c * k + r]; };
-  for (int r = 0; r < n_; ++r) {
-    Jet2& rhs = legendre_residual_[r] = gradient_jet_[r];
-    for (int c = 0; c < n_; ++c) rhs -= H(n_ + r, c) * v[c];
-  }
-  acceleration_solve_.solve(hessian_jet_.data() + n_ * k + n_, k, legendre_residual_.data(), a);
+  velocity_hessian_jet_.evaluate(lagrangian_, q, v, v);
+  for (int r = 0; r < n_; ++r) legendre_residual_[r] = gradient_jet_[r] - velocity_hessian_jet_.along(r);
+  acceleration_solve_.solve(velocity_hessian_jet_.inertia(), n_, legendre_residual_.data(), a);
 }
 
 // The tangent form's Jacobian with a configuration-dependent mass matrix: the acceleration at jets

@@ -111,12 +111,12 @@ bool LagrangianEvaluator::verlet_steps(double* q, double* d, double* f, const do
   return true;
 }
 
-void LagrangianEvaluator::hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian) {
-  check(lagrangian_, lagrangian_.hessian_jet(q, v, hessian), "Lagrangian Hessian at jets");
+void LagrangianEvaluator::hessian_jet(const Jet2* q, const Jet2* v, int first, int count, int directions,
+                                      const Jet2* U, Jet2* out) {
+  check(lagrangian_, lagrangian_.hessian_jet(q, v, first, count, directions, U, out), "Lagrangian Hessian at jets");
   ++counters_.hessian;
-  const int k = m_ + n_;
-  for (int i = 0; i < k * k; ++i)
-    if (!isfinite(hessian[i]))
+  for (int i = 0; i < count * directions; ++i)
+    if (!isfinite(out[i]))
       throw NumericalFailure("the Lagrangian's Hessian at jets is not finite", std::nan(""), lagrangian_.origin());
 }
 

@@ -370,8 +370,9 @@ class CappedHessianJets final : public Lagrangian {
     return inner_.gradient_jet(q, v, value, gradient);
   }
   int hessian_jet_variables() const noexcept override { return capacity_; }
-  Status hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian) noexcept override {
-    return inner_.hessian_jet(q, v, hessian);
+  Status hessian_jet(const Jet2* q, const Jet2* v, int first, int count, int directions, const Jet2* U,
+                     Jet2* out) noexcept override {
+    return inner_.hessian_jet(q, v, first, count, directions, U, out);
   }
 
  private:

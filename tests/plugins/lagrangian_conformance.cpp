@@ -349,9 +349,10 @@ class LyingJets final : public Lagrangian {
     return status;
   }
   int hessian_jet_variables() const noexcept override { return inner_.hessian_jet_variables(); }
-  varia::Status hessian_jet(const varia::Jet2* q, const varia::Jet2* v, varia::Jet2* hessian) noexcept override {
-    const varia::Status status = inner_.hessian_jet(q, v, hessian);
-    if (status == nullptr && in_hessian_) scale(hessian, size() * size());
+  varia::Status hessian_jet(const varia::Jet2* q, const varia::Jet2* v, int first, int count, int directions,
+                            const varia::Jet2* U, varia::Jet2* out) noexcept override {
+    const varia::Status status = inner_.hessian_jet(q, v, first, count, directions, U, out);
+    if (status == nullptr && in_hessian_) scale(out, count * directions);
     return status;
   }
 

@@ -207,6 +207,15 @@ TEST_CASE("gradient_jet at jets of 2, 4 and 6 variables (dual numbers over fixed
 
 namespace {
 
+// L's whole Hessian at jets through Lagrangian::hessian_jet: every row, times the unit directions.
+varia::Status whole_hessian_jet(varia::Lagrangian& model, const varia::Jet2* q, const varia::Jet2* v,
+                                varia::Jet2* hessian) {
+  const int k = model.position_size() + model.velocity_size();
+  std::vector<varia::Jet2> identity(static_cast<std::size_t>(k) * k, varia::Jet2(0.0));
+  for (int j = 0; j < k; ++j) identity[static_cast<std::size_t>(j) * k + j] = varia::Jet2(1.0);
+  return model.hessian_jet(q, v, 0, k, k, identity.data(), hessian);
+}
+
 // The largest difference between L's Hessian at jets of N variables (hessian_jet) and jet
 // arithmetic on the written-out Hessian.
 template <class Model>
@@ -215,7 +224,7 @@ double hessian_jet_deviation(int N) {
   const int m = model.position_size(), k = m + model.velocity_size();
   const std::vector<varia::Jet2> z = jet_inputs(k, N);
   std::vector<varia::Jet2> hessian(k * k);
-  REQUIRE(model.hessian_jet(z.data(), z.data() + m, hessian.data()) == nullptr);
+  REQUIRE(whole_hessian_jet(model, z.data(), z.data() + m, hessian.data()) == nullptr);
   const std::vector<varia::Jet2> expected = Model::hessian(z.data(), z.data() + m);
   double worst = 0.0;
   for (int i = 0; i < k * k; ++i) worst = std::max(worst, jet_distance(hessian[i], expected[i], N));
@@ -236,13 +245,13 @@ TEST_CASE("hessian_jet at jets of 1 to 6 variables (forward over forward mode wi
   CHECK(model.hessian_jet_variables() == 6);
   std::vector<varia::Jet2> hessian(16);
   const std::vector<varia::Jet2> z = jet_inputs(4, 7);
-  const varia::Status status = model.hessian_jet(z.data(), z.data() + 2, hessian.data());
+  const varia::Status status = whole_hessian_jet(model, z.data(), z.data() + 2, hessian.data());
   REQUIRE(status != nullptr);
   CHECK(std::string(status) == "an autodiff Lagrangian gives its Hessian at jets of at most 6 variables "
                                "(hessian_jet_variables())");
   // Constant inputs: the Hessian at doubles.
   const std::vector<varia::Jet2> constants(4, varia::Jet2(0.4));
-  REQUIRE(model.hessian_jet(constants.data(), constants.data() + 2, hessian.data()) == nullptr);
+  REQUIRE(whole_hessian_jet(model, constants.data(), constants.data() + 2, hessian.data()) == nullptr);
   const std::vector<double> at(4, 0.4);
   const std::vector<double> expected = Coupled::hessian(at.data(), at.data() + 2);
   for (int i = 0; i < 16; ++i) {
@@ -301,7 +310,7 @@ TEST_CASE("hessian_jet above the stack size (a dense model of 10 + 10 numbers wi
     CAPTURE(N);
     const std::vector<varia::Jet2> z = jet_inputs(k, N);
     std::vector<varia::Jet2> hessian(k * k);
-    REQUIRE(model.hessian_jet(z.data(), z.data() + 10, hessian.data()) == nullptr);
+    REQUIRE(whole_hessian_jet(model, z.data(), z.data() + 10, hessian.data()) == nullptr);
     const std::vector<varia::Jet2> expected = model.hessian(z.data(), z.data() + 10);
     double worst = 0.0;
     for (int i = 0; i < k * k; ++i) worst = std::max(worst, jet_distance(hessian[i], expected[i], N));
@@ -309,12 +318,37 @@ TEST_CASE("hessian_jet above the stack size (a dense model of 10 + 10 numbers wi
   }
   const std::vector<varia::Jet2> constants(k, varia::Jet2(0.4));
   std::vector<varia::Jet2> hessian(k * k);
-  REQUIRE(model.hessian_jet(constants.data(), constants.data() + 10, hessian.data()) == nullptr);
+  REQUIRE(whole_hessian_jet(model, constants.data(), constants.data() + 10, hessian.data()) == nullptr);
   const std::vector<double> at(k, 0.4);
   const std::vector<double> expected = model.hessian(at.data(), at.data() + 10);
   for (int i = 0; i < k * k; ++i) {
     CHECK(hessian[i].constant());
     CHECK(hessian[i].value == doctest::Approx(expected[i]).epsilon(1e-15));
+  }
+}
+
+TEST_CASE("hessian_jet gives the rows it is asked for times directions that are themselves jets: the velocity rows "
+          "times (v, 0) and the unit velocity directions, as the Euler-Lagrange field asks (ABI 19), equal jet "
+          "arithmetic on the written-out Hessian") {
+  VaryingMassChain model(10);
+  const int n = 10, k = 20;
+  for (int N : {1, 4, 6}) {
+    CAPTURE(N);
+    const std::vector<varia::Jet2> z = jet_inputs(k, N);
+    std::vector<varia::Jet2> directions(static_cast<std::size_t>(n + 1) * k, varia::Jet2(0.0));
+    for (int j = 0; j < n; ++j) directions[static_cast<std::size_t>(j) * k + n + j] = varia::Jet2(1.0);
+    for (int c = 0; c < n; ++c) directions[static_cast<std::size_t>(n) * k + c] = z[n + c];
+    std::vector<varia::Jet2> out(static_cast<std::size_t>(n) * (n + 1));
+    REQUIRE(model.hessian_jet(z.data(), z.data() + n, n, n, n + 1, directions.data(), out.data()) == nullptr);
+    const std::vector<varia::Jet2> H = model.hessian(z.data(), z.data() + n);
+    double worst = 0.0;
+    for (int r = 0; r < n; ++r) {
+      for (int j = 0; j < n; ++j) worst = std::max(worst, jet_distance(out[j * n + r], H[(n + j) * k + n + r], N));
+      varia::Jet2 along(0.0);
+      for (int c = 0; c < n; ++c) along += H[c * k + n + r] * z[n + c];
+      worst = std::max(worst, jet_distance(out[n * n + r], along, N));
+    }
+    CHECK(worst < 1e-13);
   }
 }
 
@@ -339,10 +373,10 @@ TEST_CASE("a dense model of sizes read at run time allocates at construction onl
   const std::vector<varia::Jet2> constants(200, varia::Jet2(0.4));
   std::vector<varia::Jet2> hessian(200 * 200);
   const std::size_t asked = heap_bytes();
-  REQUIRE(small.hessian_jet(constants.data(), constants.data() + 100, hessian.data()) == nullptr);
+  REQUIRE(whole_hessian_jet(small, constants.data(), constants.data() + 100, hessian.data()) == nullptr);
   CHECK(heap_bytes() - asked >= 200 * 200 * sizeof(double));
   const std::size_t again = heap_bytes();
-  REQUIRE(small.hessian_jet(constants.data(), constants.data() + 100, hessian.data()) == nullptr);
+  REQUIRE(whole_hessian_jet(small, constants.data(), constants.data() + 100, hessian.data()) == nullptr);
   CHECK(heap_bytes() == again);  // sized once
 }
 

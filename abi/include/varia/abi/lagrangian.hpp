@@ -63,12 +63,18 @@ class Lagrangian : public PluginObject {
   // Whether gradient_jet is implemented: constructions that need it refuse the Lagrangian when
   // they are built (`validate`, exit 2) rather than at the first step.
   virtual bool evaluates_at_jets() const noexcept { return false; }
-  // L's Hessian in z = (q, v) at jet inputs: the (m+n)^2 jets of d2L/dz dz (q(x), v(x)), dense,
-  // column-major, for jets of at most hessian_jet_variables() variables. The shooting construction's
-  // lagrangian form integrates the Euler-Lagrange field in (q, v) with it when the mass matrix
-  // L_vv depends on (q, v): the acceleration M^{-1} (L_q - L_vq v) and its second-order jets need
-  // L's derivatives to fourth order. The SDK's AutodiffLagrangian implements it for every model.
-  virtual Status hessian_jet(const Jet2* /*q*/, const Jet2* /*v*/, Jet2* /*hessian*/) noexcept {
+  // Rows of L's Hessian in z = (q, v) at jet inputs, times directions: with k = m + n, the jets
+  //   out[j count + r] = sum_c d2L/dz_{first + r} dz_c (q(x), v(x)) U_j[c],  r < count, j < directions,
+  // U_j the k jets at U + j k (a direction may itself be a jet: the Euler-Lagrange field's L_vq v
+  // takes U = (v, 0)), for jets of at most hessian_jet_variables() variables. The shooting
+  // construction integrates the Euler-Lagrange field at jets with it when the mass matrix depends
+  // on the point: the acceleration M^{-1} (L_q - L_vq v) (on a Lie group the Euler-Poincare field's
+  // L_xixi and L_xig g') and its second-order jets need L's derivatives to fourth order, and only
+  // these rows (the velocity's) and these directions (the velocity's unit vectors, and one more).
+  // The caller sizes the request, so a model pays for what the field uses, not for (m + n)^2 jets.
+  // The SDK's AutodiffLagrangian implements it for every model. ABI 19 (ABI 10's whole Hessian).
+  virtual Status hessian_jet(const Jet2* /*q*/, const Jet2* /*v*/, int /*first*/, int /*count*/, int /*directions*/,
+                             const Jet2* /*U*/, Jet2* /*out*/) noexcept {
     return "this Lagrangian does not give its Hessian at jets (derive it from sdk::AutodiffLagrangian)";
   }
   // The most jet variables hessian_jet takes (0: not implemented); constructions refuse a larger

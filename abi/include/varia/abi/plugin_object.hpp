@@ -30,7 +30,8 @@ namespace varia {
 // 16: the constraint kind (constraint.hpp, Kind::constraint); Lagrangian::space_dim.
 // 17: Manifold::defining_constraint (an embedded manifold served with its equations' multipliers).
 // 18: Constraint::quadratic (a constant Hessian, which the shooting construction's shot needs).
-inline constexpr int kAbiVersion = 18;
+// 19: Lagrangian::hessian_jet gives rows of the Hessian times directions the caller sizes.
+inline constexpr int kAbiVersion = 19;
 
 using Status = const char*;
 

@@ -10,8 +10,8 @@
 // natural chart's velocity gives at second order (dexp_{-xi} v = v - 1/2 [xi, v] + ...). With a
 // constant inertia J (L = 1/2 xi . J xi - V(g): the rigid body, the heavy top) mu = J xi, L_xig = 0
 // and the solve is J^{-1}; otherwise (a chain of bodies, whose inertia depends on their attitudes)
-// L's Hessian gives L_xixi and L_xig, at doubles and at jets (Lagrangian::hessian_jet), and the
-// solve at jets is MechanicalField's (JetLinearSolve, mechanical_field.hpp).
+// L's Hessian gives L_xixi and L_xig, at doubles (and at jets its velocity rows give L_xixi and
+// L_xig g', Lagrangian::hessian_jet), and the solve at jets is MechanicalField's (JetLinearSolve, mechanical_field.hpp).
 // Runge-Kutta methods integrate the field in the embedding and leave the group; a Lie group
 // method sees TG as the group G x g acting on itself: xi(y) = (xi, xi') in g x g and
 // y . exp(eta) = (g exp(eta_g), xi + eta_xi) (Manifold::translate at jets, retract at doubles).
@@ -70,7 +70,6 @@ class LieGroupField final : public EulerLagrangeField {
   void rates(const T* y, const T* D, const T* gradient, T* velocity, T* rate);
   // L_xig at the prepared Hessian: row b (of xi), column k (of g).
   double mixed(int b, int k) const { return hessian_(m_ + b, k); }
-  const Jet2& mixed_jet(int b, int k) const { return hessian_jet_[k * (m_ + n_) + m_ + b]; }
   // rate = L_xixi^{-1} torque (J^{-1} for a constant inertia).
   void solve_inertia(const double* torque, double* rate);
   void solve_inertia(const Jet2* torque, Jet2* rate);
@@ -84,12 +83,12 @@ class LieGroupField final : public EulerLagrangeField {
       f_jet_;
   Eigen::VectorXd momentum_, torque_, group_velocity_;
   std::vector<Jet2> group_velocity_jet_;
-  // A configuration-dependent inertia: L's Hessian at doubles and at jets, L_xixi's LU at doubles
-  // and its solve at jets (sized in the constructor).
+  // A configuration-dependent inertia: L's Hessian at doubles, its velocity rows at jets (L_xixi
+  // and L_xig g'), L_xixi's LU at doubles and its solve at jets (sized in the constructor).
   int hessian_jet_variables_ = 0;
   Eigen::MatrixXd hessian_;
   Eigen::PartialPivLU<Eigen::MatrixXd> inertia_lu_;
-  std::vector<Jet2> hessian_jet_;
+  VelocityHessianJet velocity_hessian_jet_;
   JetLinearSolve inertia_solve_;
 };
 

@@ -58,6 +58,24 @@ class JetLinearSolve {
   std::vector<Jet2> residual_, correction_;
 };
 
+// The rows of L's Hessian at jets that an Euler-Lagrange field with a configuration-dependent mass
+// matrix takes (Lagrangian::hessian_jet), for L(q, v) of m + n numbers: the velocity block L_vv
+// (the directions e_v) and L_vq u for one direction u of the point's numbers (g' on a Lie group,
+// v on R^n), n (n + 1) jets in one request instead of L's (m + n)^2.
+class VelocityHessianJet {
+ public:
+  VelocityHessianJet(int m, int n);
+  // At jets (q, v), with u's m numbers.
+  void evaluate(LagrangianEvaluator& lagrangian, const Jet2* q, const Jet2* v, const Jet2* u);
+  // L_vv, column-major (stride n), and (L_vq u)_r.
+  const Jet2* inertia() const { return out_.data(); }
+  const Jet2& along(int r) const { return out_[static_cast<std::size_t>(n_) * n_ + r]; }
+
+ private:
+  int m_, n_;
+  std::vector<Jet2> directions_, out_;  // the n unit directions (constant), then u's; the products
+};
+
 // Whether the Lagrangian declares a constant mass matrix (Lagrangian::constant_mass_matrix).
 bool declares_constant_mass(const Lagrangian& lagrangian);
 
@@ -191,7 +209,8 @@ class MechanicalField final : public EulerLagrangeField {
   Eigen::VectorXd rhs_;
   Eigen::PartialPivLU<Eigen::MatrixXd> mass_lu_;  // L_vv at the last state (not constant_mass())
   std::vector<Jet2> v_jet_, gradient_jet_, legendre_residual_;  // the last also acceleration()'s right side
-  std::vector<Jet2> hessian_jet_, seed_, acceleration_jet_, correction_jet_;  // correction_jet_: M^{-1} times a residual
+  VelocityHessianJet velocity_hessian_jet_;
+  std::vector<Jet2> seed_, acceleration_jet_, correction_jet_;  // correction_jet_: M^{-1} times a residual
   JetLinearSolve acceleration_solve_;  // sized for the general tangent form only
   int hessian_jet_variables_;  // the Lagrangian's (Lagrangian::hessian_jet_variables)
   SolverOptions legendre_options_;

@@ -47,8 +47,9 @@ class LagrangianEvaluator {
   // L (if value is not null) and its m + n gradient numbers at jet inputs. Counted as a Hessian
   // evaluation: it carries second-order information.
   void gradient_jet(const Jet2* q, const Jet2* v, Jet2* value, Jet2* gradient);
-  // L's (m+n)^2 Hessian numbers at jet inputs, dense column-major. Counted as a Hessian evaluation.
-  void hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian);
+  // Rows first .. first + count - 1 of L's Hessian at jet inputs times `directions` jet vectors of
+  // m + n numbers (Lagrangian::hessian_jet): out[j count + r]. Counted as a Hessian evaluation.
+  void hessian_jet(const Jet2* q, const Jet2* v, int first, int count, int directions, const Jet2* U, Jet2* out);
   // `steps` Stormer-Verlet steps run inside the plugin (kernel::StormerVerletSteps, where the
   // plugin offers it), counted as that many gradients. False where a result is not
   // finite: a non-finite gradient makes q non-finite from the next step on, and q stays so, so the

@@ -167,20 +167,22 @@ class AutodiffLagrangian : public Lagrangian {
     });
   }
   int hessian_jet_variables() const noexcept final { return kMaxHessianJetVariables; }
-  Status hessian_jet(const Jet2* q, const Jet2* v, Jet2* hessian) noexcept final {
+  Status hessian_jet(const Jet2* q, const Jet2* v, int first, int count, int directions, const Jet2* U,
+                     Jet2* out) noexcept final {
     return guarded(error_, [&] {
-      const int variables = jet_variables(q, v);
-      if (variables == 0) return hessian_at_constants(q, v, hessian);
+      const int variables = jet_variables(q, v, directions, U);
+      const HessianRows rows{first, count, directions, U, out};
+      if (variables == 0) return hessian_at_constants(q, v, rows);
       if (variables > kMaxHessianJetVariables)
         throw std::length_error("an autodiff Lagrangian gives its Hessian at jets of at most " +
                                 std::to_string(kMaxHessianJetVariables) + " variables (hessian_jet_variables())");
       if constexpr (kFixed) {
         if constexpr (kFixedJetVariables > 0 && kFixedJetVariables < kMaxHessianJetVariables)
-          if (variables <= kFixedJetVariables) return hessian_at_stack_jets<kFixedJetVariables>(q, v, variables, hessian);
-        hessian_at_stack_jets<kMaxHessianJetVariables>(q, v, variables, hessian);
+          if (variables <= kFixedJetVariables) return hessian_at_stack_jets<kFixedJetVariables>(q, v, variables, rows);
+        hessian_at_stack_jets<kMaxHessianJetVariables>(q, v, variables, rows);
       } else {
-        hessian_jet_q_.resize(m_), hessian_jet_v_.resize(n_), hessian_jet_z_.resize(m_ + n_);
-        hessian_at_jets(hessian_jet_q_, hessian_jet_v_, hessian_jet_z_.data(), q, v, variables, hessian);
+        hessian_jet_q_.resize(m_), hessian_jet_v_.resize(n_);
+        hessian_at_jets(hessian_jet_q_, hessian_jet_v_, q, v, variables, rows);
       }
     });
   }
@@ -320,10 +322,16 @@ class AutodiffLagrangian : public Lagrangian {
   }
 #pragma GCC diagnostic pop
 
-  // The number of variables of the jets (q, v) (0 when all are constants).
+  // The number of variables of the jets (q, v) (0 when all are constants), or of the directions U.
   int jet_variables(const Jet2* q, const Jet2* v) const {
     for (int i = 0; i < m_ + n_; ++i)
       if (const Jet2& z = at(q, v, m_, i); !z.constant()) return static_cast<int>(z.gradient.size());
+    return 0;
+  }
+  int jet_variables(const Jet2* q, const Jet2* v, int directions, const Jet2* U) const {
+    if (const int variables = jet_variables(q, v); variables > 0) return variables;
+    for (int i = 0; i < directions * (m_ + n_); ++i)
+      if (!U[i].constant()) return static_cast<int>(U[i].gradient.size());
     return 0;
   }
   // gradient_jet at jets of N variables: the model at dual numbers over FixedJet<N> (N + N^2
@@ -372,47 +380,67 @@ class AutodiffLagrangian : public Lagrangian {
   }
 #pragma GCC diagnostic pop
 
-  // L's Hessian at jets of `variables` <= N variables (held as FixedJet<N>, padded with zero
-  // derivatives): forward over forward mode with jet values, the outer level
-  // Eigen's AutoDiffScalar, the inner a JetTangent (jet_tangent.hpp), kHessianJetDirections
-  // directions each: one pass of the model per pair of blocks (a, b), b >= a, whose second
-  // derivatives give H(a.., b..) and, by symmetry, H(b.., a..). Sizes given at compile time: over
-  // dual inputs on the stack; read at run time: over the workspace's (any size).
+  // Lagrangian::hessian_jet's request: rows first .. first + count - 1 of L's Hessian times the
+  // directions U_0 .. U_{d-1} (m + n jets each), into out[j count + r].
+  struct HessianRows {
+    int first, count, directions;
+    const Jet2* U;
+    Jet2* out;
+  };
+  // Those products at jets of `variables` <= N variables (held as FixedJet<N>, padded with zero
+  // derivatives): forward over forward mode with jet values, the outer level Eigen's
+  // AutoDiffScalar seeded with the rows' unit vectors, the inner a JetTangent (jet_tangent.hpp)
+  // seeded with the directions, kHessianJetDirections of each a pass: one pass of the model per
+  // block of rows and block of directions, whose second derivatives are H(rows, :) U. Sizes given
+  // at compile time: over dual inputs on the stack; read at run time: over the workspace's (any
+  // size).
   template <int N>
-  void hessian_at_stack_jets(const Jet2* q, const Jet2* v, int variables, Jet2* hessian) const {
-    std::array<FixedJet<N>, kMaxFixedVariables> z;
+  void hessian_at_stack_jets(const Jet2* q, const Jet2* v, int variables, const HessianRows& rows) {
     Vec<HessianJetDual<N>> qd(m_), vd(n_);
-    hessian_at_jets(qd, vd, z.data(), q, v, variables, hessian);
+    hessian_at_jets(qd, vd, q, v, variables, rows);
   }
-  template <class Outer, int N>
-  void hessian_at_jets(Vec<Outer>& qd, Vec<Outer>& vd, FixedJet<N>* z, const Jet2* q, const Jet2* v, int variables,
-                       Jet2* hessian) const {
+  template <int N>
+  static FixedJet<N> padded(const Jet2& x, int variables) {
+    FixedJet<N> z(x.value);
+    if (x.constant()) return z;
+    z.is_constant = false;
+    z.gradient.head(variables) = x.gradient;
+    z.hessian.topLeftCorner(variables, variables) = x.hessian;
+    return z;
+  }
+  template <class Outer>
+  void hessian_at_jets(Vec<Outer>& qd, Vec<Outer>& vd, const Jet2* q, const Jet2* v, int variables,
+                       const HessianRows& rows) {
     constexpr int K = kHessianJetDirections;
     using Inner = typename Outer::Scalar;
+    using J = std::remove_cvref_t<decltype(std::declval<Inner>().value)>;
+    constexpr int N = decltype(J::gradient)::RowsAtCompileTime;
     const int k = m_ + n_;
-    for (int i = 0; i < k; ++i) {
-      const Jet2& x = at(q, v, m_, i);
-      z[i] = FixedJet<N>(x.value);
-      if (x.constant()) continue;
-      z[i].is_constant = false;
-      z[i].gradient.head(variables) = x.gradient;
-      z[i].hessian.topLeftCorner(variables, variables) = x.hessian;
-    }
-    for (int a = 0; a < k; a += K)
-      for (int b = a; b < k; b += K) {
+    auto& z = hessian_jet_workspace<J>();
+    z.resize(static_cast<std::size_t>(k) * (1 + rows.directions));  // (q, v), then the directions
+    for (int i = 0; i < k; ++i) z[i] = padded<N>(at(q, v, m_, i), variables);
+    for (int i = 0; i < k * rows.directions; ++i) z[k + i] = padded<N>(rows.U[i], variables);
+    for (int a = 0; a < rows.count; a += K)
+      for (int b = 0; b < rows.directions; b += K) {
         for (int i = 0; i < k; ++i) {
           Outer& x = input(qd, vd, i);
           x.value() = Inner(z[i]);
-          if (i >= b && i < b + K) x.value().derivatives[i - b] = FixedJet<N>(1.0);
+          for (int j = 0; j < K && b + j < rows.directions; ++j) x.value().derivatives[j] = z[k + (b + j) * k + i];
           x.derivatives().resize(K);
-          for (int j = 0; j < K; ++j) x.derivatives()(j) = Inner(i == a + j ? 1.0 : 0.0);
+          for (int j = 0; j < K; ++j) x.derivatives()(j) = Inner(i == rows.first + a + j ? 1.0 : 0.0);
         }
         const Outer r = model().lagrangian(qd, vd);
-        for (int j = 0; j < K && a + j < k; ++j)
-          for (int i = 0; i < K && b + i < k; ++i)
-            hessian[(a + j) * k + b + i] = hessian[(b + i) * k + a + j] =
-                truncated(derivative(r, j).derivatives[i], variables);
+        for (int j = 0; j < K && a + j < rows.count; ++j)
+          for (int i = 0; i < K && b + i < rows.directions; ++i)
+            rows.out[(b + i) * rows.count + a + j] = truncated(derivative(r, j).derivatives[i], variables);
       }
+  }
+  // The padded jets of (q, v) and the directions, for jets J: a workspace per jet size, sized at its
+  // first use.
+  template <class J>
+  std::vector<J>& hessian_jet_workspace() {
+    if constexpr (std::is_same_v<J, FixedJet<kMaxHessianJetVariables>>) return hessian_jet_z_;
+    else return hessian_jet_small_z_;
   }
   template <int N>
   static Jet2 truncated(const FixedJet<N>& x, int variables) {
@@ -421,15 +449,22 @@ class AutodiffLagrangian : public Lagrangian {
     jet.hessian = x.hessian.topLeftCorner(variables, variables);
     return jet;
   }
-  // Constant inputs: the Hessian at their values (evaluate's, at any size), as constant jets.
-  void hessian_at_constants(const Jet2* q, const Jet2* v, Jet2* hessian) {
+  // Constant inputs and directions: the Hessian at their values (evaluate's, at any size) times the
+  // directions' values, as constant jets.
+  void hessian_at_constants(const Jet2* q, const Jet2* v, const HessianRows& rows) {
     const int k = m_ + n_;
     at_constants_.resize(k), hessian_at_constants_.resize(static_cast<std::size_t>(k) * k);
     for (int i = 0; i < k; ++i) at_constants_[i] = at(q, v, m_, i).value;
     if (const Status status = evaluate(at_constants_.data(), at_constants_.data() + m_, nullptr, nullptr,
                                        hessian_at_constants_.data()))
       throw std::runtime_error(status);
-    for (std::size_t i = 0; i < hessian_at_constants_.size(); ++i) hessian[i] = Jet2(hessian_at_constants_[i]);
+    for (int j = 0; j < rows.directions; ++j)
+      for (int r = 0; r < rows.count; ++r) {
+        double sum = 0.0;
+        for (int c = 0; c < k; ++c)
+          sum += hessian_at_constants_[static_cast<std::size_t>(c) * k + rows.first + r] * rows.U[j * k + c].value;
+        rows.out[j * rows.count + r] = Jet2(sum);
+      }
   }
 
   // L, gradient and Hessian by forward mode nested once (derivatives of derivatives).
@@ -494,6 +529,8 @@ class AutodiffLagrangian : public Lagrangian {
   Vec<ChunkDual2> chunk2_q_, chunk2_v_;
   Vec<ChunkHessianJetDual> hessian_jet_q_, hessian_jet_v_;
   std::vector<FixedJet<kMaxHessianJetVariables>> hessian_jet_z_;
+  std::vector<FixedJet<(kFixedJetVariables > 0 && kFixedJetVariables < kMaxHessianJetVariables ? kFixedJetVariables : 1)>>
+      hessian_jet_small_z_;  // hessian_at_stack_jets<kFixedJetVariables>'s
   std::vector<double> at_constants_, hessian_at_constants_;
 };
 

@@ -131,16 +131,28 @@ inline void check_jets(Lagrangian& lagrangian, unsigned seed, const VectorXd& q,
           return gradient;
         },
         [&](double eps) { return at_doubles(eps).gradient; }, "the gradient", failures);
-  if (lagrangian.hessian_jet_variables() >= 1)
-    check_at_jets(
-        [&](double eps) {
-          const std::vector<Jet2> x = line_jets(z, d, eps);
-          std::vector<Jet2> hessian(k * k);
-          check(lagrangian, lagrangian.hessian_jet(x.data(), x.data() + m, hessian.data()),
-                "Lagrangian Hessian at jets");
-          return hessian;
-        },
-        [&](double eps) { return at_doubles(eps).hessian.reshaped().eval(); }, "the Hessian", failures);
+  if (lagrangian.hessian_jet_variables() < 1) return;
+  // Rows 1.. of the Hessian (all but the first, so that a request's offset is checked) times the unit
+  // directions and one more random direction u: H(1.., :) [I, u].
+  const VectorXd u = random_direction(k, engine);
+  std::vector<Jet2> directions(static_cast<std::size_t>(k) * (k + 1), Jet2(0.0));
+  for (int j = 0; j < k; ++j) directions[j * k + j] = Jet2(1.0);
+  for (int c = 0; c < k; ++c) directions[k * k + c] = Jet2(u(c));
+  check_at_jets(
+      [&](double eps) {
+        const std::vector<Jet2> x = line_jets(z, d, eps);
+        std::vector<Jet2> rows(static_cast<std::size_t>(k - 1) * (k + 1));
+        check(lagrangian, lagrangian.hessian_jet(x.data(), x.data() + m, 1, k - 1, k + 1, directions.data(), rows.data()),
+              "Lagrangian Hessian at jets");
+        return rows;
+      },
+      [&](double eps) {
+        Eigen::MatrixXd product(k - 1, k + 1);
+        const Eigen::MatrixXd H = at_doubles(eps).hessian;
+        product << H.bottomRows(k - 1), H.bottomRows(k - 1) * u;
+        return product.reshaped().eval();
+      },
+      "the Hessian", failures);
 }
 
 // Where the plugin runs the explicit form's Stormer-Verlet steps itself (kernel::StormerVerletSteps), five
