@@ -19,37 +19,46 @@ namespace varia::sdk {
 
 template <class J, int K>
 struct JetTangent {
-  JetTangent() : JetTangent(0.0) {}
+  // Default-constructed it is uninitialized, as a double and a FixedJet are: Eigen constructs
+  // every element of its vectors of dual numbers' derivatives, and zeroing K + 1 jets each time was
+  // half of L's Hessian at jets (bench/README.md). JetTangent(0.0) is the zero.
+  JetTangent() = default;
   JetTangent(double constant) : JetTangent(J(constant)) {}  // NOLINT: constants convert implicitly
   JetTangent(const J& x) : value(x) { derivatives.fill(J(0.0)); }  // NOLINT: as a double does
 
   J value;
   std::array<J, K> derivatives;  // along the K directions of this level
 
+  // A result whose value is f and whose derivatives the operation writes next, every one.
+  static JetTangent result(const J& f) {
+    JetTangent r;
+    r.value = f;
+    return r;
+  }
   // f(a) from f(a.value) and f'(a.value).
   static JetTangent chain(const JetTangent& a, const J& f, const J& slope) {
-    JetTangent r(f);
+    JetTangent r = result(f);
     for (int i = 0; i < K; ++i) r.derivatives[i] = slope * a.derivatives[i];
     return r;
   }
 
   friend JetTangent operator+(const JetTangent& a, const JetTangent& b) {
-    JetTangent r(a.value + b.value);
+    JetTangent r = result(a.value + b.value);
     for (int i = 0; i < K; ++i) r.derivatives[i] = a.derivatives[i] + b.derivatives[i];
     return r;
   }
   friend JetTangent operator-(const JetTangent& a, const JetTangent& b) {
-    JetTangent r(a.value - b.value);
+    JetTangent r = result(a.value - b.value);
     for (int i = 0; i < K; ++i) r.derivatives[i] = a.derivatives[i] - b.derivatives[i];
     return r;
   }
   friend JetTangent operator*(const JetTangent& a, const JetTangent& b) {
-    JetTangent r(a.value * b.value);
+    JetTangent r = result(a.value * b.value);
     for (int i = 0; i < K; ++i) r.derivatives[i] = a.derivatives[i] * b.value + a.value * b.derivatives[i];
     return r;
   }
   friend JetTangent operator/(const JetTangent& a, const JetTangent& b) {
-    JetTangent r(a.value / b.value);
+    JetTangent r = result(a.value / b.value);
     for (int i = 0; i < K; ++i) r.derivatives[i] = (a.derivatives[i] - r.value * b.derivatives[i]) / b.value;
     return r;
   }
@@ -80,7 +89,7 @@ struct JetTangent {
   friend JetTangent abs(const JetTangent& a) { return a.value < J(0.0) ? -a : a; }
   friend JetTangent atan2(const JetTangent& y, const JetTangent& x) {
     const J squared = x.value * x.value + y.value * y.value;
-    JetTangent r(atan2(y.value, x.value));
+    JetTangent r = result(atan2(y.value, x.value));
     for (int i = 0; i < K; ++i) r.derivatives[i] = (x.value * y.derivatives[i] - y.value * x.derivatives[i]) / squared;
     return r;
   }
