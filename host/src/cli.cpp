@@ -88,7 +88,7 @@ struct Options {
   bool json = false;
   std::string verify_json, cost_out;
   std::vector<double> verify_h;
-  bool verify_explain = false;
+  bool verify_explain = false, verify_quiet = false;
   CostOptions cost;
 };
 
@@ -253,8 +253,12 @@ void define_verify(CLI::App& app, Options& o, Command& chosen) {
       ->delimiter(',')
       ->allow_extra_args(false)
       ->type_name("H,H,..");
+  verify->add_flag("--quiet", o.verify_quiet,
+                   "no progress line (on a terminal verify shows each run's step and the time it has left)");
   verify->callback([&] {
-    chosen = [&] { return command_verify(o.common, o.scene, o.verify_json, o.verify_h, o.verify_explain); };
+    chosen = [&] {
+      return command_verify(o.common, o.scene, o.verify_json, o.verify_h, o.verify_explain, o.verify_quiet);
+    };
   });
 }
 

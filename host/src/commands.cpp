@@ -320,12 +320,12 @@ int command_tangent(const CommonOptions& common, const std::string& scene_file, 
 }
 
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,
-                   const std::vector<double>& h, bool explain) {
+                   const std::vector<double>& h, bool explain, bool quiet) {
   if (!json_file.empty()) check_distinct({{"scene", scene_file}}, {{"--json", json_file}});
   return with_registry(common, [&](Registry& registry) {
     Prepared prepared = prepare(scene_file, common, registry);
     check_fit_steps(prepared.scene, h);
-    const auto checks = verify_scene(prepared.scene, prepared.assembly, registry, h);
+    const auto checks = verify_scene(prepared.scene, prepared.assembly, registry, h, !quiet);
     fmt::print(results(), "{}", checks_table(checks, explain));
     if (!json_file.empty()) write_json_file(json_file, nlohmann::ordered_json(checks_json(checks)), "--json");
     std::vector<std::string> failed, unmeasured;

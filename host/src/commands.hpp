@@ -68,6 +68,6 @@ nlohmann::ordered_json tangent_map(Prepared& prepared, const TangentOptions& opt
 // Prints the table of checks (and writes them as JSON when json_file is not empty); 1 when a
 // property the theorems predict was measured not to hold.
 int command_verify(const CommonOptions& common, const std::string& scene_file, const std::string& json_file,
-                   const std::vector<double>& h, bool explain);
+                   const std::vector<double>& h, bool explain, bool quiet);
 
 }  // namespace varia::host

@@ -12,6 +12,7 @@
 #include "commands.hpp"
 #include "constructions/parts.hpp"
 #include "interrupt.hpp"
+#include "progress.hpp"
 #include "verify_checks.hpp"
 
 namespace varia::host {
@@ -34,6 +35,16 @@ PropertyCheck not_measured(const char* name, json predicted, const char* why) {
   PropertyCheck c = check_of(name, std::move(predicted));
   c.note = why;
   return c;
+}
+
+void run_from_start(VerifiedScene& x, DiscreteHamiltonianMap& map, const std::string& what, double h, long steps,
+                    const std::function<void(long, const double*, const double*)>& observe) {
+  const std::string unit = fmt::format("{} at h = {:.4g}: step", what, h);
+  ProgressLine progress(unit.c_str(), steps, !x.progress);
+  run(map, x.a.q0, x.a.p0, x.a.t0, h, steps, [&](long step, const double* q, const double* p) {
+    observe(step, q, p);
+    progress.update(step);
+  });
 }
 
 void stop_before(const char* property, double h) {
@@ -290,7 +301,7 @@ LongRun long_run(VerifiedScene& x, double h, long steps) {
   std::vector<double> J(std::max(k, 0)), J0(J.size()), v(x.n, 0.0);
   double E0 = 0.0, scale = 1.0;
   within("momentum_conserved and energy_bounded", h, [&] {
-    run(*x.a.map, x.a.q0, x.a.p0, x.a.t0, h, steps, [&](long step, const double* q, const double* p) {
+    run_from_start(x, *x.a.map, "the energy and momentum run", h, steps, [&](long step, const double* q, const double* p) {
       v = velocity_of(x, q, p, v);
       const double E = x.lagrangian.energy(q, v.data());
       if (step == 0) E0 = E;
@@ -355,9 +366,9 @@ bool PropertyCheck::unmeasured() const {
 }
 
 std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& a, Registry& registry,
-                                        const std::vector<double>& h) {
+                                        const std::vector<double>& h, bool progress) {
   VerifiedScene x{scene, a, registry, LagrangianEvaluator(*a.lagrangian), scene.construction->predict(scene, a),
-            a.manifold->dim(), a.manifold->point_size(), h};
+            a.manifold->dim(), a.manifold->point_size(), h, progress};
   std::vector<PropertyCheck> checks{self_adjoint(x), g_invariant(x), ld_order(x), global_order(x)};
   const std::vector<LongRun> runs{long_run(x, scene.step, kLongRun), long_run(x, scene.step / 2, 2 * kLongRun)};
   checks.push_back(momentum_conserved(x, runs));

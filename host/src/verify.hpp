@@ -37,9 +37,10 @@ struct PropertyCheck {
 void check_fit_steps(const Scene& scene, const std::vector<double>& h);
 
 // `h`: the step sizes the orders are fitted at (varia verify --h, checked by check_fit_steps);
-// empty: verify chooses them.
+// empty: verify chooses them. `progress`: a progress line on stderr through the runs (where it is
+// a terminal, progress.hpp).
 std::vector<PropertyCheck> verify_scene(const Scene& scene, Assembly& assembly, Registry& registry,
-                                        const std::vector<double>& h = {});
+                                        const std::vector<double>& h = {}, bool progress = false);
 nlohmann::json checks_json(const std::vector<PropertyCheck>& checks);
 // The table `verify` prints: property, predicted, measured, tolerance, holds, and why a property
 // was not measured (at most kShortReason characters); with `explain`, each row's whole note (the

@@ -6,9 +6,11 @@
 
 #include <fmt/format.h>
 
+#include <functional>
 #include <limits>
 #include <nlohmann/json.hpp>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "assemble.hpp"
@@ -33,7 +35,13 @@ struct VerifiedScene {
   Predictions predictions;
   int n, m;
   const std::vector<double>& given_h;  // --h: the step sizes of the order fits, else chosen
+  bool progress = false;               // a progress line through each run (not --quiet)
 };
+
+// The scene's map over `steps` steps of h from its start, `observe` at each state (step, q, p),
+// with a progress line naming `what` where x.progress.
+void run_from_start(VerifiedScene& x, DiscreteHamiltonianMap& map, const std::string& what, double h, long steps,
+                    const std::function<void(long, const double*, const double*)>& observe);
 
 nlohmann::json prediction(const std::optional<bool>& p);
 nlohmann::json prediction(const std::optional<int>& p);

@@ -307,10 +307,9 @@ double state_distance(VerifiedScene& x, const double* q, const double* p, const 
 
 void final_state(DiscreteHamiltonianMap& map, VerifiedScene& x, double h, long steps, std::vector<double>& q,
                  std::vector<double>& p) {
-  run(map, x.a.q0, x.a.p0, x.a.t0, h, steps,
-      [&](long k, const double* qk, const double* pk) {
-        if (k == steps) q.assign(qk, qk + x.m), p.assign(pk, pk + x.n);
-      });
+  run_from_start(x, map, "an order run", h, steps, [&](long k, const double* qk, const double* pk) {
+    if (k == steps) q.assign(qk, qk + x.m), p.assign(pk, pk + x.n);
+  });
 }
 
 // The state at time T after the start: exact where the whole system (Lagrangian and forces) has a

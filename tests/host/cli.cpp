@@ -328,5 +328,25 @@ TEST_CASE("--set replaces values at JSON pointers before the scene is checked, a
   CHECK(run_varia("cost scenes/default.json --set /step=0.2 --quiet --h 0.2,0.1,0.05,0.025 --out '" + dir.path().string() + "'").code == 0);
 }
 
+
+TEST_CASE("on a terminal verify shows its runs' progress, with the time left, and --quiet silences it, off a "
+          "terminal there is no progress line") {
+  // script(1) gives the command a terminal and copies what it shows to stdout.
+  const std::string verify = varia() + " verify scenes/multibody/spherical-pendulum-rod-rk4.json";
+  const auto shown = run_shell("script -qec \"" + verify + "\" /dev/null");
+  REQUIRE(shown.code == 0);
+  CHECK(contains(shown.out, "varia: the energy and momentum run at h = 0.01: step "));
+  CHECK(contains(shown.out, "of 4000"));
+  CHECK(contains(shown.out, "s left"));
+  CHECK(contains(shown.out, "varia: an order run at h = "));
+  const auto quiet = run_shell("script -qec \"" + verify + " --quiet\" /dev/null");
+  REQUIRE(quiet.code == 0);
+  CHECK(!contains(quiet.out, "s left"));
+  CHECK(contains(quiet.out, "energy_bounded"));  // the table is still printed
+  const auto piped = run_varia("verify scenes/multibody/spherical-pendulum-rod-rk4.json");
+  REQUIRE(piped.code == 0);
+  CHECK(!contains(piped.err, "s left"));
+}
+
 }  // namespace
 }  // namespace varia::test
