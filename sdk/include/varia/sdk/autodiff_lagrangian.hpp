@@ -424,16 +424,29 @@ class AutodiffLagrangian : public Lagrangian {
       for (int b = 0; b < rows.directions; b += K) {
         for (int i = 0; i < k; ++i) {
           Outer& x = input(qd, vd, i);
-          x.value() = Inner(z[i]);
-          for (int j = 0; j < K && b + j < rows.directions; ++j) x.value().derivatives[j] = z[k + (b + j) * k + i];
+          x.value() = inner_seed<Inner>(z, k, i, b, rows.directions);
           x.derivatives().resize(K);
           for (int j = 0; j < K; ++j) x.derivatives()(j) = Inner(i == rows.first + a + j ? 1.0 : 0.0);
         }
         const Outer r = model().lagrangian(qd, vd);
         for (int j = 0; j < K && a + j < rows.count; ++j)
           for (int i = 0; i < K && b + i < rows.directions; ++i)
-            rows.out[(b + i) * rows.count + a + j] = truncated(derivative(r, j).derivatives[i], variables);
+            rows.out[(b + i) * rows.count + a + j] = truncated(derivative(r, j).derivative(i), variables);
       }
+  }
+  // Input i's inner dual number: its jet z[i] with the directions b .. b + K - 1 (those of the
+  // `directions` that exist), z[k + j k + i] for direction j; a constant where all of them are zero
+  // (a unit direction is zero but in one input), so that its derivatives are not carried.
+  template <class Inner, class J>
+  static Inner inner_seed(const std::vector<J>& z, int k, int i, int b, int directions) {
+    constexpr int K = kHessianJetDirections;
+    std::array<J, K> d;
+    bool zero = true;
+    for (int j = 0; j < K; ++j) {
+      d[j] = b + j < directions ? z[k + (b + j) * k + i] : J(0.0);
+      zero = zero && d[j].constant() && d[j].value == 0.0;
+    }
+    return zero ? Inner(z[i]) : Inner(z[i], d);
   }
   // The padded jets of (q, v) and the directions, for jets J: a workspace per jet size, sized at its
   // first use.

@@ -19,47 +19,72 @@ namespace varia::sdk {
 
 template <class J, int K>
 struct JetTangent {
-  // Default-constructed it is uninitialized, as a double and a FixedJet are: Eigen constructs
-  // every element of its vectors of dual numbers' derivatives, and zeroing K + 1 jets each time was
-  // half of L's Hessian at jets (bench/README.md). JetTangent(0.0) is the zero.
-  JetTangent() = default;
-  JetTangent(double constant) : JetTangent(J(constant)) {}  // NOLINT: constants convert implicitly
-  JetTangent(const J& x) : value(x) { derivatives.fill(J(0.0)); }  // NOLINT: as a double does
+  // Default-constructed its value is uninitialized, as a double and a FixedJet are (Eigen
+  // constructs every element of its vectors of dual numbers' derivatives), a constant whose
+  // derivatives are not stored. JetTangent(0.0) is the zero.
+  JetTangent() : constant(true) {}
+  JetTangent(double c) : value(c), constant(true) {}  // NOLINT: constants convert implicitly
+  JetTangent(const J& x) : value(x), constant(true) {}            // NOLINT: as a double does
+  // x with the derivatives d[0..K-1] along this level's directions.
+  JetTangent(const J& x, const std::array<J, K>& d) : value(x), derivatives(d), constant(false) {}
+  // A constant's derivatives are not stored, and not copied.
+  JetTangent(const JetTangent& other) : value(other.value), constant(other.constant) {
+    if (!constant) derivatives = other.derivatives;
+  }
+  JetTangent& operator=(const JetTangent& other) {
+    value = other.value;
+    constant = other.constant;
+    if (!constant) derivatives = other.derivatives;
+    return *this;
+  }
 
   J value;
-  std::array<J, K> derivatives;  // along the K directions of this level
+  // Along the K directions of this level; not stored (zero) where `constant`: a double of the model
+  // (a mass, a body vector) converts to a JetTangent at every use, and zeroing and multiplying its
+  // K derivative jets was most of L's Hessian at jets (bench/README.md).
+  std::array<J, K> derivatives;
+  bool constant;
 
-  // A result whose value is f and whose derivatives the operation writes next, every one.
-  static JetTangent result(const J& f) {
-    JetTangent r;
-    r.value = f;
-    return r;
-  }
+  // The derivative along direction i.
+  const J& derivative(int i) const { return constant ? kZero : derivatives[i]; }
+
   // f(a) from f(a.value) and f'(a.value).
   static JetTangent chain(const JetTangent& a, const J& f, const J& slope) {
-    JetTangent r = result(f);
+    if (a.constant) return JetTangent(f);
+    JetTangent r = varying(f);
     for (int i = 0; i < K; ++i) r.derivatives[i] = slope * a.derivatives[i];
     return r;
   }
 
   friend JetTangent operator+(const JetTangent& a, const JetTangent& b) {
-    JetTangent r = result(a.value + b.value);
+    if (b.constant) return a.constant ? JetTangent(a.value + b.value) : JetTangent(a.value + b.value, a.derivatives);
+    if (a.constant) return JetTangent(a.value + b.value, b.derivatives);
+    JetTangent r = varying(a.value + b.value);
     for (int i = 0; i < K; ++i) r.derivatives[i] = a.derivatives[i] + b.derivatives[i];
     return r;
   }
   friend JetTangent operator-(const JetTangent& a, const JetTangent& b) {
-    JetTangent r = result(a.value - b.value);
-    for (int i = 0; i < K; ++i) r.derivatives[i] = a.derivatives[i] - b.derivatives[i];
+    if (b.constant) return a.constant ? JetTangent(a.value - b.value) : JetTangent(a.value - b.value, a.derivatives);
+    JetTangent r = varying(a.value - b.value);
+    for (int i = 0; i < K; ++i) r.derivatives[i] = a.constant ? -b.derivatives[i] : a.derivatives[i] - b.derivatives[i];
     return r;
   }
   friend JetTangent operator*(const JetTangent& a, const JetTangent& b) {
-    JetTangent r = result(a.value * b.value);
-    for (int i = 0; i < K; ++i) r.derivatives[i] = a.derivatives[i] * b.value + a.value * b.derivatives[i];
+    if (a.constant && b.constant) return JetTangent(a.value * b.value);
+    JetTangent r = varying(a.value * b.value);
+    for (int i = 0; i < K; ++i)
+      r.derivatives[i] = a.constant   ? a.value * b.derivatives[i]
+                         : b.constant ? a.derivatives[i] * b.value
+                                      : a.derivatives[i] * b.value + a.value * b.derivatives[i];
     return r;
   }
   friend JetTangent operator/(const JetTangent& a, const JetTangent& b) {
-    JetTangent r = result(a.value / b.value);
-    for (int i = 0; i < K; ++i) r.derivatives[i] = (a.derivatives[i] - r.value * b.derivatives[i]) / b.value;
+    if (a.constant && b.constant) return JetTangent(a.value / b.value);
+    JetTangent r = varying(a.value / b.value);
+    for (int i = 0; i < K; ++i)
+      r.derivatives[i] = a.constant   ? -(r.value * b.derivatives[i]) / b.value
+                         : b.constant ? a.derivatives[i] / b.value
+                                      : (a.derivatives[i] - r.value * b.derivatives[i]) / b.value;
     return r;
   }
   friend JetTangent operator-(const JetTangent& a) { return chain(a, -a.value, J(-1.0)); }
@@ -88,25 +113,41 @@ struct JetTangent {
   }
   friend JetTangent abs(const JetTangent& a) { return a.value < J(0.0) ? -a : a; }
   friend JetTangent atan2(const JetTangent& y, const JetTangent& x) {
+    if (y.constant && x.constant) return JetTangent(atan2(y.value, x.value));
     const J squared = x.value * x.value + y.value * y.value;
-    JetTangent r = result(atan2(y.value, x.value));
-    for (int i = 0; i < K; ++i) r.derivatives[i] = (x.value * y.derivatives[i] - y.value * x.derivatives[i]) / squared;
+    JetTangent r = varying(atan2(y.value, x.value));
+    for (int i = 0; i < K; ++i) r.derivatives[i] = (x.value * y.derivative(i) - y.value * x.derivative(i)) / squared;
     return r;
   }
   // a^b = exp(b log a): d = b a^(b-1) da + a^b log(a) db, the second term where log a exists (a
   // varying exponent of a base <= 0 has no derivative).
   friend JetTangent pow(const JetTangent& a, const JetTangent& b) {
     JetTangent r = chain(a, pow(a.value, b.value), b.value * pow(a.value, b.value - 1.0));
-    if (!(a.value > J(0.0))) return r;
+    if (b.constant || !(a.value > J(0.0))) return r;
     const J log_a = log(a.value);
-    for (int i = 0; i < K; ++i) r.derivatives[i] += r.value * log_a * b.derivatives[i];
+    for (int i = 0; i < K; ++i) {
+      const J term = r.value * log_a * b.derivatives[i];
+      r.derivatives[i] = r.constant ? term : r.derivatives[i] + term;
+    }
+    r.constant = false;
     return r;
   }
   friend bool isfinite(const JetTangent& a) {
     bool finite = isfinite(a.value);
+    if (a.constant) return finite;
     for (const J& d : a.derivatives) finite = finite && isfinite(d);
     return finite;
   }
+
+ private:
+  // A result whose value is f and whose derivatives the operation writes next, every one.
+  static JetTangent varying(const J& f) {
+    JetTangent r;
+    r.value = f;
+    r.constant = false;
+    return r;
+  }
+  static inline const J kZero = J(0.0);
 };
 
 }  // namespace varia::sdk
