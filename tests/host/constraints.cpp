@@ -70,15 +70,18 @@ State6 reference_state(const State6& start, double T) {
 }
 
 // The spherical pendulum on a rod under `method` at four step sizes halving from h0 to T = 1: the
-// largest errors in q and p against the RKF7(8) reference, and the order fitted to them.
-OrderFit spherical_pendulum_order(const json& method, double h0) {
-  Registry registry{Registry::search_path({})};
+// largest errors in q and p against the RKF7(8) reference, and the order fitted to them. With
+// `constraints`, those instead of the scene's rod (plugins also from the tests' own directory).
+OrderFit spherical_pendulum_order(const json& method, double h0, const json& constraints = nullptr) {
+  Registry registry{Registry::search_path({VARIA_FAULT_PLUGIN_DIR})};
   const double T = 1.0;
   std::vector<double> hs, errors;
   State6 truth{};
   for (double h = h0; hs.size() < 4; h /= 2) {
     Scene scene;
-    Assembly a = assembled(spherical_pendulum(method, h, std::lround(T / h)), registry, scene);
+    json document = spherical_pendulum(method, h, std::lround(T / h));
+    if (!constraints.is_null()) document["system"]["constraints"] = constraints;
+    Assembly a = assembled(document, registry, scene);
     if (hs.empty()) {
       for (int k = 0; k < 3; ++k) truth[k] = a.q0[k], truth[3 + k] = a.v0[k];
       truth = reference_state(truth, T);
@@ -478,6 +481,47 @@ TEST_SUITE("long") {
     CAPTURE(outcome.err);
     CHECK(outcome.code == 0);
     CHECK(test::contains(outcome.out, "symplectic"));
+  }
+}
+
+// A constraint that is not quadratic: tests/fault_plugins/quartic_anchor.cpp writes the rod from the
+// origin as (|x|^4 - 1) / 4, the same zero set and normals. Galerkin (its Newton Jacobian takes the
+// weighted Hessian at every point) and an explicit one-step method move the pendulum as on the rod;
+// the implicit one-step method and shooting, which need quadratic constraints, refuse it at
+// /system/constraints (spec), naming the method's need.
+TEST_CASE("a constraint that is not quadratic moves the pendulum as the rod with the same zero set does under galerkin "
+          "and rk4, and implicit one-step methods and shooting refuse it at /system/constraints") {
+  Registry registry{Registry::search_path({VARIA_FAULT_PLUGIN_DIR})};
+  const auto final_q = [&](const json& method, bool quartic) {
+    json document = spherical_pendulum(method, 0.01, 100);
+    if (quartic) document["system"]["constraints"] = json::array({{{"type", "quartic-anchor"}}});
+    Scene scene;
+    Assembly a = assembled(document, registry, scene);
+    Trajectory trajectory(*a.map, a.q0, a.p0, a.t0, scene.step);
+    trajectory.advance(scene.steps);
+    return Eigen::VectorXd(trajectory.q());
+  };
+  // Galerkin holds g = 0 at the control points and the multiplier's term along the same normal: the
+  // same discrete motion, to round-off.
+  const double apart = (final_q(galerkin_lobatto(2), true) - final_q(galerkin_lobatto(2), false)).cwiseAbs().maxCoeff();
+  MESSAGE("galerkin degree 2: the quartic constraint and the rod 100 steps apart by ", apart);
+  CHECK(apart < 1e-13);
+  // The index-1 fields of the two differ off the sphere, where rk4's stages are: another method of
+  // the same order on the same motion, measured against the reference.
+  const json quartic = json::array({{{"type", "quartic-anchor"}}});
+  const OrderFit fit = spherical_pendulum_order({{"construction", "one-step"}, {"one_step", {{"type", "rk4"}}}}, 0.02, quartic);
+  CHECK(fit.used == 4);
+  CHECK(std::abs(fit.slope - 4) <= 0.25);
+  const std::pair<json, const char*> refused[] = {
+      {{{"construction", "one-step"}, {"one_step", {{"type", "implicit-midpoint"}}}},
+       "/system/constraints: with constraints that are not quadratic the one-step construction takes explicit"},
+      {constrained_shooting("rk4", "simpson"),
+       "/system/constraints: with constraints the shooting construction takes quadratic constraints only"}};
+  for (const auto& [method, message] : refused) {
+    json document = spherical_pendulum(method, 0.01, 10);
+    document["system"]["constraints"] = json::array({{{"type", "quartic-anchor"}}});
+    Scene scene;
+    CHECK_THROWS_WITH_AS(assembled(document, registry, scene), doctest::Contains(message), InputError);
   }
 }
 
