@@ -106,11 +106,17 @@ void LieGroupField::prepare(const Jet2* y) {
   check(manifold_, manifold_.generators(y, generators_jet_.data()), "manifold generators");
   lagrangian_.gradient_jet(y, y + m_, nullptr, gradient_jet_.data());
   if (constant_mass_) return;
-  for (int k = 0; k < m_; ++k) {  // g' = D xi, the direction of L_xig g'
-    Jet2& sum = group_velocity_jet_[k] = Jet2(0.0);
-    for (int a = 0; a < n_; ++a) sum += generators_jet_[k * n_ + a] * y[m_ + a];
-  }
+  group_velocity_of(generators_jet_.data(), y + m_, group_velocity_jet_.data());  // the direction of L_xig g'
   velocity_hessian_jet_.evaluate(lagrangian_, y, y + m_, group_velocity_jet_.data());
+}
+
+template <class T>
+void LieGroupField::group_velocity_of(const T* D, const T* xi, T* velocity) const {
+  for (int k = 0; k < m_; ++k) {
+    T sum(0.0);
+    for (int a = 0; a < n_; ++a) sum += D[k * n_ + a] * xi[a];
+    velocity[k] = sum;
+  }
 }
 
 // g' = D xi;  L_xixi xi' = ad*_xi mu + D^T dL/dg - L_xig g', with (ad*_xi mu)_b =
@@ -119,24 +125,21 @@ template <class T>
 void LieGroupField::rates(const T* y, const T* D, const T* gradient, T* velocity, T* rate) {
   T* mu;
   T* torque;
-  T* group_velocity;
+  const T* xi = y + m_;
+  // g' = D xi: at doubles for L_xig g' (into `velocity` when asked for); at jets prepare() formed it
+  // for L_xig g' with a configuration-dependent inertia, and it is only written out.
+  [[maybe_unused]] double* group_velocity = nullptr;
   if constexpr (std::is_same_v<T, double>) {
     mu = momentum_.data();
     torque = torque_.data();
-    group_velocity = group_velocity_.data();
+    group_velocity = velocity != nullptr ? velocity : group_velocity_.data();
+    if (velocity != nullptr || !constant_mass_) group_velocity_of(D, xi, group_velocity);
   } else {
     mu = momentum_jet_.data();
     torque = torque_jet_.data();
-    group_velocity = group_velocity_jet_.data();
+    if (velocity != nullptr && constant_mass_) group_velocity_of(D, xi, velocity);
+    else if (velocity != nullptr) std::copy(group_velocity_jet_.begin(), group_velocity_jet_.end(), velocity);
   }
-  const T* xi = y + m_;
-  if (velocity != nullptr) group_velocity = velocity;
-  if (velocity != nullptr || !constant_mass_)
-    for (int k = 0; k < m_; ++k) {
-      T sum(0.0);
-      for (int a = 0; a < n_; ++a) sum += D[k * n_ + a] * xi[a];
-      group_velocity[k] = sum;
-    }
   for (int c = 0; c < n_; ++c) {
     if (!constant_mass_) {
       mu[c] = gradient[m_ + c];

@@ -70,6 +70,9 @@ class LieGroupField final : public EulerLagrangeField {
   void rates(const T* y, const T* D, const T* gradient, T* velocity, T* rate);
   // L_xig at the prepared Hessian: row b (of xi), column k (of g).
   double mixed(int b, int k) const { return hessian_(m_ + b, k); }
+  // velocity = D xi, the group velocity g'.
+  template <class T>
+  void group_velocity_of(const T* D, const T* xi, T* velocity) const;
   // rate = L_xixi^{-1} torque (J^{-1} for a constant inertia).
   void solve_inertia(const double* torque, double* rate);
   void solve_inertia(const Jet2* torque, Jet2* rate);
