@@ -48,6 +48,7 @@ ConstrainedField::ConstrainedField(LagrangianEvaluator& lagrangian, HolonomicCon
       constraints_(constraints),
       m_(constraints.size()),
       quadratic_(constraints.quadratic()),
+      has_jacobian_(constraints.gives_curvature_derivative()),
       point_(n_),
       values_(m_),
       unit_(Eigen::VectorXd::Zero(m_)),
@@ -185,13 +186,15 @@ Status ConstrainedField::eval(const Jet2* y, Jet2* f) noexcept {
   return evaluate(y, f);
 }
 
-// The derivative of a = u - W lambda in z = (q, v), u = M^-1 L_q, for quadratic constraints
-// (dG_i/dq = H_i, dc/dq = 0): with r = W lambda and H_lambda = sum_i lambda_i H_i,
-//   S dlambda = R dz,  R = G du + [((H_i (u - r))^T, 2 (H_i v)^T)]_i - [G M^-1 H_lambda, 0],
+// The derivative of a = u - W lambda in z = (q, v), u = M^-1 L_q (dG_i/dq = H_i): with r = W lambda,
+// H_lambda = sum_i lambda_i H_i and C = dc/dq (Constraint::curvature_derivative, zero for quadratic
+// constraints),
+//   S dlambda = R dz,  R = G du + [((H_i (u - r))^T + C_i, 2 (H_i v)^T)]_i - [G M^-1 H_lambda, 0],
 //   da = du - [M^-1 H_lambda, 0] dz - W dlambda.
 Status ConstrainedField::jacobian(const double* y, double* f, double* df) noexcept {
-  if (!quadratic_) return "the constrained field (index 1) has a Jacobian for quadratic constraints only: its "
-                          "multiplier's derivatives would need the constraints' third derivatives";
+  if (!has_jacobian_)
+    return "the constrained field (index 1) has a Jacobian where the constraints give the derivative of v^T H_i(q) v "
+           "in q (Constraint::curvature_derivative) only: its multiplier's derivatives need them";
   if (Status status = evaluate(y, f)) return status;
   return guard([&] {
     Workspace<double>& w = doubles_;
@@ -209,6 +212,10 @@ Status ConstrainedField::jacobian(const double* y, double* f, double* df) noexce
       R_.row(i).head(n_) += scratch_.transpose();
       scratch_.noalias() = constraints_.hessian() * v;
       R_.row(i).tail(n_) += 2.0 * scratch_.transpose();
+    }
+    if (!quadratic_) {
+      constraints_.evaluate_curvature_derivative(y, y + n_);
+      R_.leftCols(n_) += constraints_.curvature_derivative();
     }
     constraints_.evaluate_hessian(y, w.multiplier.data());
     K_.noalias() = inverse_mass_ * constraints_.hessian();

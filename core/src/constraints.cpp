@@ -60,10 +60,16 @@ HolonomicConstraints::HolonomicConstraints(std::vector<Constraint*> constraints,
     for (Eigen::Index e = 0; e < part.hessian_values.size(); ++e) part.hessian_slots.push_back(hessian_positions[k++]);
   }
   g_.resize(m_);
+  curvature_derivative_ = jacobian_;  // the same pattern and slots
 }
 
 bool HolonomicConstraints::quadratic() const {
   return std::all_of(parts_.begin(), parts_.end(), [](const Part& part) { return part.constraint->quadratic(); });
+}
+
+bool HolonomicConstraints::gives_curvature_derivative() const {
+  return std::all_of(parts_.begin(), parts_.end(),
+                     [](const Part& part) { return part.constraint->gives_curvature_derivative(); });
 }
 
 void HolonomicConstraints::values(const double* q, double* g) {
@@ -80,6 +86,17 @@ void HolonomicConstraints::evaluate_jacobian(const double* q, double* g) {
           part.constraint->evaluate(q, g == nullptr ? nullptr : g + part.first_row, part.jacobian_values.data()),
           "constraint evaluate");
     check_finite(*part.constraint, part.jacobian_values.data(), static_cast<int>(part.jacobian_values.size()), "Jacobian");
+    for (std::size_t e = 0; e < part.jacobian_slots.size(); ++e) values[part.jacobian_slots[e]] = part.jacobian_values[e];
+  }
+}
+
+void HolonomicConstraints::evaluate_curvature_derivative(const double* q, const double* v) {
+  double* values = curvature_derivative_.valuePtr();
+  for (Part& part : parts_) {
+    check(*part.constraint, part.constraint->curvature_derivative(q, v, part.jacobian_values.data()),
+          "constraint curvature_derivative");
+    check_finite(*part.constraint, part.jacobian_values.data(), static_cast<int>(part.jacobian_values.size()),
+                 "curvature derivative");
     for (std::size_t e = 0; e < part.jacobian_slots.size(); ++e) values[part.jacobian_slots[e]] = part.jacobian_values[e];
   }
 }

@@ -18,9 +18,9 @@ std::unique_ptr<EulerLagrangeField> field_of(Manifold& manifold, LagrangianEvalu
     auto field = std::make_unique<ConstrainedField>(lagrangian, *constraints);
     if (method.explicit_tableau().stages == 0 && !field->has_jacobian())
       throw ConstraintsRefused(
-          "with constraints that are not quadratic the one-step construction takes explicit Runge-Kutta methods only "
-          "(an implicit method's stages need the constrained field's Jacobian, whose multiplier's derivatives need "
-          "the constraints' third derivatives)");
+          "with constraints that do not give the derivative of v^T H_i(q) v in q (Constraint::curvature_derivative) "
+          "the one-step construction takes explicit Runge-Kutta methods only (an implicit method's stages need the "
+          "constrained field's Jacobian, whose multiplier's derivatives need those third derivatives of g)");
     return field;
   }
   if (!manifold.is_vector_space()) return std::make_unique<LieGroupField>(manifold, lagrangian);

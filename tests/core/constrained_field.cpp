@@ -27,10 +27,11 @@ struct Bead : sdk::AutodiffLagrangian<Bead, 3, 3> {
 
 constexpr double kEps = 1e-5;
 
+template <class Sphere = UnitSphere>
 struct Setup {
   Bead bead;
   LagrangianEvaluator lagrangian{bead};
-  UnitSphere sphere;
+  Sphere sphere;
   HolonomicConstraints constraints{{&sphere}, 3};
   ConstrainedField field{lagrangian, constraints};
   // A state off the sphere and its tangent space: the field is defined on all of R^6.
@@ -47,6 +48,16 @@ struct Setup {
     REQUIRE(field.jacobian(z.data(), f.data(), J.data()) == nullptr);
     return J;
   }
+  // |J - central differences of the field| at y.
+  double jacobian_deviation() {
+    Eigen::MatrixXd differences(6, 6);
+    for (int k = 0; k < 6; ++k) {
+      const Eigen::VectorXd e = Eigen::VectorXd::Unit(6, k) * kEps;
+      differences.col(k) = (rate(y + e) - rate(y - e)) / (2 * kEps);
+    }
+    const Eigen::MatrixXd deviation = jacobian(y) - differences;
+    return deviation.lpNorm<Eigen::Infinity>();
+  }
 };
 
 // The 6 state numbers as jets of 6 variables.
@@ -59,21 +70,28 @@ std::vector<Jet2> seeded(const Eigen::VectorXd& z) {
 }  // namespace
 
 TEST_CASE("the constrained field's Jacobian (a quadratic constraint) equals central differences of the field") {
-  Setup s;
-  const Eigen::MatrixXd J = s.jacobian(s.y);
-  Eigen::MatrixXd differences(6, 6);
-  for (int k = 0; k < 6; ++k) {
-    const Eigen::VectorXd e = Eigen::VectorXd::Unit(6, k) * kEps;
-    differences.col(k) = (s.rate(s.y + e) - s.rate(s.y - e)) / (2 * kEps);
-  }
-  const double error = (J - differences).lpNorm<Eigen::Infinity>();
-  MESSAGE("|J - differences| = ", error, " (|J| = ", J.lpNorm<Eigen::Infinity>(), ")");
+  Setup<> s;
+  const double error = s.jacobian_deviation();
+  MESSAGE("|J - differences| = ", error);
   CHECK(error <= 1e-8);
-  CHECK(J.bottomLeftCorner(3, 3).lpNorm<Eigen::Infinity>() >= 0.1);  // the multiplier's q-derivatives enter
+  CHECK(s.jacobian(s.y).bottomLeftCorner(3, 3).lpNorm<Eigen::Infinity>() >= 0.1);  // the multiplier's q-derivatives enter
+}
+
+// Not quadratic: the multiplier's derivative in q takes the constraint's curvature derivative
+// (Constraint::curvature_derivative), without which the q-columns would differ by W S^-1 C.
+TEST_CASE("the constrained field's Jacobian (a quartic constraint, with its curvature derivative) equals central "
+          "differences of the field") {
+  Setup<QuarticSphere> s;
+  const double error = s.jacobian_deviation();
+  MESSAGE("|J - differences| = ", error);
+  CHECK(error <= 1e-8);
+  // Where it must not hold: a wrong curvature derivative moves the Jacobian off the differences.
+  s.sphere.cross = 3.0;
+  CHECK(s.jacobian_deviation() >= 1e-3);
 }
 
 TEST_CASE("at jets the constrained field gives its value, its Jacobian and the differences of its Jacobian") {
-  Setup s;
+  Setup<> s;
   const std::vector<Jet2> y = seeded(s.y);
   std::vector<Jet2> f(6);
   REQUIRE(s.field.eval(y.data(), f.data()) == nullptr);
@@ -97,7 +115,7 @@ TEST_CASE("at jets the constrained field gives its value, its Jacobian and the d
 }
 
 TEST_CASE("the projection at jets differentiates the projection at doubles, to second order") {
-  Setup s;
+  Setup<> s;
   const SolverOptions options;
   const Eigen::VectorXd start = (Eigen::VectorXd(6) << 0.52, -0.41, -0.79, 0.7, 1.1, -0.3).finished();  // |q| = 1.02
   const auto projected = [&](const Eigen::VectorXd& z) {

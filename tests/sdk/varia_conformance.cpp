@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include "../core/sphere_constraints.hpp"
+#include "varia/sdk/conformance/constraint.hpp"
 #include "varia/sdk/conformance/force.hpp"
 #include "varia/sdk/conformance/lagrangian.hpp"
 #include "varia/sdk/force_base.hpp"
@@ -214,6 +216,17 @@ TEST_CASE("varia-conformance refuses an effect whose gradient is 1.5 times V's d
   CHECK(reported_slope(outcome.out, "the gradient is not V's derivative") == doctest::Approx(1.0).epsilon(0.05));
   // Its Hessian, the identity, is not the derivative of the gradient it reports (1.5 I) either.
   CHECK(reported_slope(outcome.out, "the Hessian is not the gradient's derivative") ==
+        doctest::Approx(1.0).epsilon(0.05));
+}
+
+TEST_CASE("the constraint suite refuses a curvature derivative with a wrong term, and accepts the right one") {
+  std::mt19937 engine(11);
+  varia::testing::QuarticSphere right, wrong;
+  wrong.cross = 3.0;
+  CHECK(varia::sdk::conformance::check_constraint(right, 3, engine).empty());
+  const auto failures = varia::sdk::conformance::check_constraint(wrong, 3, engine);
+  REQUIRE(failures.list().size() >= 1);
+  CHECK(reported_slope(failures.list()[0], "curvature_derivative is not the derivative of v^T H_i(q) v in q") ==
         doctest::Approx(1.0).epsilon(0.05));
 }
 

@@ -3,8 +3,10 @@
 // of sum_i lambda_i g_i for given multipliers lambda, which the constructions need for the exact
 // Newton Jacobian of the constrained discrete Euler-Lagrange equations (docs/constraints.md).
 // Model evaluations only: a construction decides where and with which multipliers g enters.
-// ABI 16; quadratic() ABI 18.
+// ABI 16; quadratic() ABI 18; curvature_derivative() ABI 20.
 #pragma once
+
+#include <algorithm>
 
 #include "varia/abi/plugin_object.hpp"
 
@@ -35,6 +37,18 @@ class Constraint : public PluginObject {
   // follow exactly from their values at one point (docs/constraints.md). The SDK's conformance
   // suite checks the declaration (the Hessian at random points).
   virtual bool quadratic() const noexcept { return false; }
+  // The derivatives in q of c_i(q, v) = v^T H_i(q) v, H_i the Hessian of g_i (the term of
+  // d^2/dt^2 g_i = G_i q'' + c_i that does not hold the acceleration), their values in
+  // jacobian_pattern's order: c_i depends on q_j only where g_i does. The index-1 constrained field's
+  // Jacobian needs them (an implicit one-step method's stage Newton, docs/constraints.md): they are
+  // g's third derivatives along v twice. A quadratic constraint's are zero, which the default gives;
+  // a constraint that is not quadratic gives them where gives_curvature_derivative() says so.
+  virtual bool gives_curvature_derivative() const noexcept { return quadratic(); }
+  virtual Status curvature_derivative(const double* /*q*/, const double* /*v*/, double* values) noexcept {
+    const int *rows = nullptr, *cols = nullptr;
+    std::fill_n(values, jacobian_pattern(&rows, &cols), 0.0);
+    return quadratic() ? nullptr : "this constraint does not give the derivatives of v^T H_i(q) v in q";
+  }
 };
 
 }  // namespace varia

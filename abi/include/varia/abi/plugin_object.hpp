@@ -31,7 +31,8 @@ namespace varia {
 // 17: Manifold::defining_constraint (an embedded manifold served with its equations' multipliers).
 // 18: Constraint::quadratic (a constant Hessian, which the shooting construction's shot needs).
 // 19: Lagrangian::hessian_jet gives rows of the Hessian times directions the caller sizes.
-inline constexpr int kAbiVersion = 19;
+// 20: Constraint::curvature_derivative (the derivative in q of v^T H_i(q) v, for implicit methods).
+inline constexpr int kAbiVersion = 20;
 
 using Status = const char*;
 

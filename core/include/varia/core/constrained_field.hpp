@@ -13,9 +13,10 @@
 // jet follow exactly from their values at the jet's value, g(q + d) = g + G d + d^T H d / 2), at
 // second-order jets: there the projection's Newton iteration runs two iterations past the values'
 // convergence, which make the first and then the second derivatives exact. One template serves
-// both. The field's Jacobian (an implicit method's stage Newton) is exact for quadratic constraints
-// only, where c's derivative in q vanishes (see jacobian()); otherwise it would need g's third
-// derivatives, and the constructions take explicit Runge-Kutta methods only.
+// both. The field's Jacobian (an implicit method's stage Newton) needs c's derivative in q, g's
+// third derivatives along v twice (Constraint::curvature_derivative: zero for quadratic
+// constraints); where a constraint does not give it, the constructions take explicit Runge-Kutta
+// methods only.
 #pragma once
 
 #include <Eigen/Core>
@@ -35,10 +36,10 @@ class ConstrainedField final : public EulerLagrangeField {
   Status eval(const double* y, double* f) noexcept override;
   // Quadratic constraints only (else the Status says so).
   Status eval(const Jet2* y, Jet2* f) noexcept override;
-  // Quadratic constraints only (else the Status says so).
+  // Constraints that give c's derivative only (else the Status says so).
   Status jacobian(const double* y, double* f, double* df) noexcept override;
-  // Whether the field has its Jacobian (quadratic constraints): implicit methods may integrate it.
-  bool has_jacobian() const { return quadratic_; }
+  // Whether the field has its Jacobian (Constraint::curvature_derivative): implicit methods may integrate it.
+  bool has_jacobian() const { return has_jacobian_; }
   // q onto g(q) = 0 (to `options.tolerance`, at most `options.max_iterations` Newton steps; throws
   // NumericalFailure otherwise), then v onto G(q) v = 0. At jets for quadratic constraints only.
   void project(double* q, double* v, const SolverOptions& options);
@@ -78,7 +79,7 @@ class ConstrainedField final : public EulerLagrangeField {
 
   HolonomicConstraints& constraints_;
   int m_;
-  bool quadratic_;
+  bool quadratic_, has_jacobian_;
   Workspace<double> doubles_;
   Workspace<Jet2> jets_;
   Eigen::VectorXd point_, values_, unit_;  // a point's values, g there (at jets), e_i

@@ -37,6 +37,9 @@ class HolonomicConstraints {
   int dim() const { return n_; }
   // Whether every constraint declares itself quadratic (Constraint::quadratic: a constant Hessian).
   bool quadratic() const;
+  // Whether every constraint gives the derivatives of c_i = v^T H_i(q) v in q
+  // (Constraint::curvature_derivative; every quadratic one does: they are zero).
+  bool gives_curvature_derivative() const;
   // g(q), m numbers.
   void values(const double* q, double* g);
   // G(q) into jacobian() (and g(q) into g when not null).
@@ -45,6 +48,9 @@ class HolonomicConstraints {
   // The Hessian of sum_i lambda_i g_i at q into hessian().
   void evaluate_hessian(const double* q, const double* lambda);
   const Eigen::SparseMatrix<double>& hessian() const { return hessian_; }
+  // dc_i/dq_j at (q, v), c_i = v^T H_i(q) v, into curvature_derivative() (m x n, G's pattern).
+  void evaluate_curvature_derivative(const double* q, const double* v);
+  const Eigen::SparseMatrix<double, Eigen::RowMajor>& curvature_derivative() const { return curvature_derivative_; }
   // max_i |g_i(q)| and max_i |(G(q) v)_i|: the observables `constraint` and `constraint_velocity`.
   double residual(const double* q);
   double velocity_residual(const double* q, const double* v);
@@ -58,7 +64,7 @@ class HolonomicConstraints {
   };
   std::vector<Part> parts_;
   int n_, m_ = 0;
-  Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian_;
+  Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian_, curvature_derivative_;
   Eigen::SparseMatrix<double> hessian_;
   Eigen::VectorXd g_;
 };

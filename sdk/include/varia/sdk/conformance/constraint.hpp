@@ -7,7 +7,9 @@
 //   - Taylor tests along random directions d (taylor.hpp): g(q + eps d) - g(q) - eps G d and
 //     G(q + eps d)^T lambda - G(q)^T lambda - eps H_lambda d fall as eps^2. A wrong Jacobian fails the
 //     first, a wrong or missing Hessian entry the second;
-//   - a constraint declaring quadratic() has the same Hessian at every random point.
+//   - a constraint declaring quadratic() has the same Hessian at every random point;
+//   - where it gives curvature_derivative() (dc_i/dq, c_i = v^T H_i(q) v), a Taylor test of
+//     v^T H_lambda(q + eps d) v - v^T H_lambda(q) v - eps lambda^T C d, C's entries in G's pattern.
 #pragma once
 
 #include <Eigen/Core>
@@ -89,6 +91,21 @@ inline Failures check_constraint(Constraint& constraint, int n, std::mt19937& en
           return (G.transpose() * lambda - c.G.transpose() * lambda - eps * H * d).norm();
         },
         std::max(scale, H.lpNorm<Eigen::Infinity>()), "the weighted Hessian is not the derivative of G^T lambda");
+    if (constraint.gives_curvature_derivative()) {
+      const Eigen::VectorXd v = random_direction(n, engine);
+      Eigen::VectorXd values(jacobian_entries);
+      check(constraint, constraint.curvature_derivative(q.data(), v.data(), values.data()), "curvature_derivative");
+      constraint.jacobian_pattern(&rows, &cols);
+      Eigen::MatrixXd C = Eigen::MatrixXd::Zero(m, n);
+      for (int e = 0; e < jacobian_entries; ++e) C(rows[e], cols[e]) = values(e);
+      const double curvature = v.dot(H * v);
+      expect_taylor(
+          failures,
+          [&](double eps) { return std::abs(v.dot(weighted_hessian(constraint, q + eps * d, lambda) * v) - curvature -
+                                            eps * lambda.dot(C * d)); },
+          std::max({scale, H.lpNorm<Eigen::Infinity>(), C.lpNorm<Eigen::Infinity>()}),
+          "curvature_derivative is not the derivative of v^T H_i(q) v in q");
+    }
     if (constraint.quadratic()) {
       const Eigen::MatrixXd elsewhere = weighted_hessian(constraint, random_point(n, engine), lambda);
       failures.expect((elsewhere - H).lpNorm<Eigen::Infinity>() <= 1e-14 * std::max(1.0, H.lpNorm<Eigen::Infinity>()),
