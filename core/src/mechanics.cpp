@@ -111,6 +111,28 @@ bool LagrangianEvaluator::verlet_steps(double* q, double* d, double* f, const do
   return true;
 }
 
+void LagrangianEvaluator::hessian_product(const double* q, const double* v, const double* u, double* out) {
+  const int k = m_ + n_;
+  Eigen::Map<Eigen::VectorXd> product(out, k);
+  const Eigen::Map<const Eigen::VectorXd> direction(u, k);
+  if (lagrangian_.hessian_jet_variables() > 0) {
+    if (product_.empty()) product_point_.resize(k), product_direction_.resize(k), product_.resize(k);
+    for (int i = 0; i < k; ++i) {
+      product_point_[i] = Jet2(i < m_ ? q[i] : v[i - m_]);
+      product_direction_[i] = Jet2(u[i]);
+    }
+    hessian_jet(product_point_.data(), product_point_.data() + m_, 0, k, 1, product_direction_.data(), product_.data());
+    for (int i = 0; i < k; ++i) out[i] = product_[i].value;
+  } else if (pattern_size_ >= 0) {
+    sparse_hessian(q, v, gradient_.data(), sparse_values_.data());
+    product.setZero();
+    for (int e = 0; e < pattern_size_; ++e) out[pattern_rows_[e]] += sparse_values_[e] * u[pattern_cols_[e]];
+  } else {
+    hessian(q, v, gradient_.data(), hessian_.data());
+    product.noalias() = hessian_ * direction;
+  }
+}
+
 void LagrangianEvaluator::hessian_jet(const Jet2* q, const Jet2* v, int first, int count, int directions,
                                       const Jet2* U, Jet2* out) {
   check(lagrangian_, lagrangian_.hessian_jet(q, v, first, count, directions, U, out), "Lagrangian Hessian at jets");

@@ -77,7 +77,8 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
       options_(options),
       solver_(options),
       m_(manifold.point_size()),
-      n_(manifold.dim() - (constraints != nullptr ? constraints->size() : 0)) {
+      n_(manifold.dim() - (constraints != nullptr ? constraints->size() : 0)),
+      adjoint_solver_(options) {
   method_.set_solver(options.tolerance, options.max_iterations);
   take_quadrature(quadrature);
   refuse_unsupported();
@@ -88,6 +89,7 @@ ShootingDiscreteLagrangian::ShootingDiscreteLagrangian(Manifold& manifold, Lagra
   size_workspace();
   if (mechanical_ != nullptr) mechanical_->set_origin(origin_.data());
   offer_explicit_shot(lagrangian);
+  offer_adjoint();
   step_ = constrained_ != nullptr ? &ShootingDiscreteLagrangian::step_on_constraint
                                   : step_function(n_, manifold_.is_vector_space());
 }
@@ -194,6 +196,20 @@ void ShootingDiscreteLagrangian::offer_explicit_shot(Lagrangian& lagrangian) {
     kernel::ExplicitShot shot;
     shot.plan = &shot_plan_;
     plugin_shoots_ = lagrangian.offers(kernel::call(shot));
+  }
+}
+
+// Where the exact Newton Jacobian takes several passes of jets (2n above the jets' capacity) and
+// the shot is one explicit recurrence at doubles, the step solves on the shot's adjoint
+// (shot_adjoint.hpp): one forward and one reverse sweep an iteration, whatever n.
+void ShootingDiscreteLagrangian::offer_adjoint() {
+  const RungeKuttaTableau tableau = method_.explicit_tableau();
+  if (passes_.size() > 1 && offsets() && field_->constant_mass() && forces_.empty() && start_correction_ == 0.0 &&
+      end_correction_ == 0.0 && tableau.stages > 0) {
+    adjoint_ = std::make_unique<ShotAdjoint>(lagrangian_, field_->inverse_mass(), tableau, nodes_, weights_,
+                                             form_ == ShootingForm::hamiltonian);
+    adjoint_guess_.resize(n_);
+    adjoint_scratch_.resize(n_);
   }
 }
 

@@ -173,7 +173,7 @@ void ShootingDiscreteLagrangian::step_at(const double* q0, const double* p0, dou
   else guess = momentum;
   warm_start<N>(continues && h == previous_h_);
   target_is_end_ = true;
-  solve<N>(q0, h, Target::momentum, p0);
+  if (adjoint_ == nullptr || !solve_by_adjoint(q0, h, p0)) solve<N>(q0, h, Target::momentum, p0);
   record_correction<N>(h);
   Eigen::Map<Vector<N>> p(p1, n);
   if (mechanical_ != nullptr) {  // a vector space: q1 - q0 is the offset B (type-2: lambda)
@@ -226,6 +226,87 @@ void ShootingDiscreteLagrangian::step_on_constraint(const double* q0, const doub
   velocity_.noalias() = field_->inverse_mass() * embedded_momentum_;
   constrained_->project_velocity(q1, velocity_.data());
   Eigen::Map<Eigen::VectorXd>(p1, m_).noalias() = field_->mass() * velocity_;
+}
+
+// The step's equations on the shot's adjoint (shot_adjoint.hpp) in the unknowns (w0, lambda):
+//   D1 + p0 = dF/deta - lambda + p0 = 0,   dF/dw0 / h = (G_w - B_w^T lambda) / h = 0,
+// the second making lambda = B_w^{-T} G_w = D2 L_d (shooting.hpp), scaled by 1/h so that both are
+// of the size of a momentum (the stopping rule's yardstick). Simplified Newton (solve/newton.hpp)
+// with the Jacobian of the flow to first order in h: q^n - q0 = h V w0 + O(h^2) and
+// G = h L(q0, V w0) + O(h^2), V = I (lagrangian) or M^{-1} (hamiltonian: w0 = p^0), so that
+//   A = [0, -I; V^T M V, -V^T]   (columns w0, lambda),
+// with the exact Jacobian's other terms O((omega h)^2) relative for a frequency omega of the
+// motion: the contraction. A's inverse is closed-form (solve()). lambda's first guess is the far
+// end's momentum, M v^n or p^n, D2 L_d to the method's order.
+struct ShootingDiscreteLagrangian::AdjointEquations {
+  ShootingDiscreteLagrangian& s;
+  const double* q0;
+  double h;
+  const double* p0;
+  bool first = true;
+
+  bool hamiltonian() const { return s.form_ == ShootingForm::hamiltonian; }
+  int size() const { return 2 * s.n_; }
+  bool simplified() const { return true; }
+  double evaluate(Eigen::Ref<Eigen::VectorXd> F) {
+    const int n = s.n_;
+    ShotAdjoint& shot = *s.adjoint_;
+    shot.forward(q0, s.w_.data(), h);
+    if (first) {
+      if (hamiltonian()) s.lambda_ = shot.end_w();
+      else s.lambda_.noalias() = s.field_->mass() * shot.end_w();
+      first = false;
+    }
+    shot.reverse(s.lambda_.data(), s.momentum_change_.data(), F.data() + n);
+    const Eigen::Map<const Eigen::VectorXd> momentum(p0, n);
+    F.head(n) = s.momentum_change_ - s.lambda_ + momentum;
+    F.tail(n) /= h;
+    return std::max({momentum.lpNorm<Eigen::Infinity>(), s.momentum_change_.lpNorm<Eigen::Infinity>(),
+                     s.lambda_.lpNorm<Eigen::Infinity>()});
+  }
+  void factorize() {}
+  // A [x; y] = [a; b]: y = -a, V^T M V x = b - V^T a: x = M^{-1} (b - a), or x = M b - a.
+  void solve(const Eigen::VectorXd& F, Eigen::VectorXd& update) {
+    const int n = s.n_;
+    update.tail(n) = -F.head(n);
+    if (hamiltonian()) {
+      update.head(n).noalias() = s.field_->mass() * F.tail(n);
+      update.head(n) -= F.head(n);
+    } else {
+      s.adjoint_scratch_ = F.tail(n) - F.head(n);
+      update.head(n).noalias() = s.field_->inverse_mass() * s.adjoint_scratch_;
+    }
+  }
+  double apply(const Eigen::VectorXd& update) {
+    const int n = s.n_;
+    s.w_ -= update.head(n);
+    s.lambda_ -= update.tail(n);
+    return std::max(s.w_.lpNorm<Eigen::Infinity>(), s.lambda_.lpNorm<Eigen::Infinity>());
+  }
+  // The outputs at the updated unknowns, to first order by A: lambda is one; the far end's offset
+  // moves by -h V dw0; D1 + p0 goes to zero by A's first row, which leaves dF/deta (the momentum
+  // change) as it was.
+  void finish(const Eigen::VectorXd& update) {
+    const int n = s.n_;
+    if (hamiltonian()) s.adjoint_scratch_.noalias() = s.field_->inverse_mass() * update.head(n);
+    else s.adjoint_scratch_ = update.head(n);
+    for (int r = 0; r < n; ++r) s.boundary_[r].value = s.adjoint_->end_offset()[r] - h * s.adjoint_scratch_[r];
+    s.residual_.setZero();
+  }
+};
+
+bool ShootingDiscreteLagrangian::solve_by_adjoint(const double* q0, double h, const double* p0) {
+  AdjointEquations equations{*this, q0, h, p0};
+  adjoint_guess_ = w_;
+  last_solver_ = &adjoint_solver_;
+  const SolveReport report = adjoint_solver_.solve(equations, statistics_);
+  if (report.outcome == SolveReport::Outcome::not_contracting) {
+    w_ = adjoint_guess_;
+    last_solver_ = &solver_;
+    return false;
+  }
+  require_converged(report, "the shooting equations");
+  return true;
 }
 
 // The warm start: w0 = guess + c, the correction c = w0 - guess of the step extrapolated from the

@@ -426,7 +426,8 @@ TEST_CASE("above the jets' capacity the shooting construction propagates its sen
           "derivatives in blocks, second derivatives in pairs of blocks of eta and w0): the trajectory is the "
           "one-pass trajectory to round-off, with a configuration-dependent mass matrix (the double pendulum's "
           "Hessian at jets capped at 2 and 4 variables) and without (coupled pendulums of dim 4, explicit and "
-          "implicit methods, and of dim 8 and 10, the last above the SDK's stack size: issue #39) (issue #18)") {
+          "implicit methods, and of dim 8 and 10, the last above the SDK's stack size, where the explicit method's "
+          "step runs on the shot's adjoint: issue #39) (issue #18)") {
   auto rule = simpson();
   auto explicit_method = rk4();
   auto implicit_method = gauss2();
@@ -460,7 +461,9 @@ TEST_CASE("above the jets' capacity the shooting construction propagates its sen
       CAPTURE(x.transpose());
       CAPTURE(y.transpose());
       CHECK((x - y).lpNorm<Eigen::Infinity>() < 1e-13);
-      CHECK(b.solver_statistics().max_iterations <= 3);
+      // Exact Newton from the warm start; above dim 6 the explicit method's step runs on the shot's
+      // adjoint, simplified Newton (shooting_solve.cpp), whose contraction here is about 0.01.
+      CHECK(b.solver_statistics().max_iterations <= (method == &explicit_method && n > 6 ? 5 : 3));
     }
   }
 }

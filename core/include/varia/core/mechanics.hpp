@@ -50,6 +50,11 @@ class LagrangianEvaluator {
   // Rows first .. first + count - 1 of L's Hessian at jet inputs times `directions` jet vectors of
   // m + n numbers (Lagrangian::hessian_jet): out[j count + r]. Counted as a Hessian evaluation.
   void hessian_jet(const Jet2* q, const Jet2* v, int first, int count, int directions, const Jet2* U, Jet2* out);
+  // L's Hessian at (q, v) times one direction u (m + n numbers) into out (m + n): by hessian_jet at
+  // constants where the plugin gives it (the SDK: a Hessian-vector product by forward over forward
+  // mode, about two gradients' cost), else from the sparse Hessian's entries, else the dense
+  // Hessian. Counted as a Hessian evaluation; its workspace is sized at the first call.
+  void hessian_product(const double* q, const double* v, const double* u, double* out);
   // `steps` Stormer-Verlet steps run inside the plugin (kernel::StormerVerletSteps, where the
   // plugin offers it), counted as that many gradients. False where a result is not
   // finite: a non-finite gradient makes q non-finite from the next step on, and q stays so, so the
@@ -106,6 +111,7 @@ class LagrangianEvaluator {
   Eigen::SparseMatrix<double> velocity_block_;  // sparse Lagrangians: d2L/dv2
   Eigen::SparseLU<Eigen::SparseMatrix<double>> sparse_lu_;
   std::vector<Eigen::Triplet<double>> triplets_;
+  std::vector<Jet2> product_point_, product_direction_, product_;  // hessian_product's, at constants
   EvaluationCounters counters_;
   NewtonSolver legendre_solver_;
 };

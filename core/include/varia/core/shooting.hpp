@@ -73,6 +73,15 @@
 // over blocks of x, and of the second derivatives only Phi's columns in w0, the Newton Jacobian's,
 // over pairs of blocks. Every pass has the same values; together they give the one-pass derivatives.
 //
+// The step on the shot's adjoint: where passes would be needed and the shot is one explicit
+// recurrence at doubles (an explicit Runge-Kutta method on R^n, a Type I form, a constant mass
+// matrix, no forces or end corrections), the step needs no second derivatives. Its unknowns are
+// (w0, lambda), its equations D1 + p0 = 0 and dF/dw0 = 0 for F = S - <lambda, B> (which makes
+// lambda = D2 L_d), whose residuals one forward and one reverse sweep give (shot_adjoint.hpp): a
+// gradient and a Hessian-vector product of L a stage, at any n. Simplified Newton solves them with
+// the Jacobian of the flow to first order in h (shooting_solve.cpp, AdjointEquations), and where it
+// does not contract the step solves with the exact Jacobian from the passes.
+//
 // Where the shot is one fixed recurrence (an explicit Runge-Kutta method, the lagrangian form on
 // R^n, a constant mass matrix, no forces, no end corrections: explicit_shot.hpp), the Lagrangian's
 // plugin runs it whole with its model inlined (kernel::ExplicitShot), where it takes the plan (the
@@ -96,6 +105,7 @@
 #include "varia/abi/manifold.hpp"
 #include "varia/core/mechanical_field.hpp"
 #include "varia/core/mechanics.hpp"
+#include "varia/core/shot_adjoint.hpp"
 #include "varia/abi/one_step.hpp"
 #include "varia/abi/quadrature.hpp"
 #include "varia/core/solve/newton.hpp"
@@ -136,7 +146,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   const SolverStatistics& stage_statistics() const { return stages_; }
   const EvaluationCounters& evaluations() const override;
   // Residual norms of the last shooting solve, one per iteration (quadratic convergence).
-  const std::vector<double>& last_residuals() const { return solver_.residuals(); }
+  const std::vector<double>& last_residuals() const { return last_solver_->residuals(); }
   // Empty on a vector space (every form, any dimension).
   std::string tangent_map_refusal() const override;
 
@@ -167,6 +177,7 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void refuse_unsupported() const;
   void size_workspace();
   void offer_explicit_shot(Lagrangian& lagrangian);
+  void offer_adjoint();
   void plan_passes(int capacity);
   // The jet of x's number `variable` (-1: none) at `value` in the current pass: one of its
   // variables, or a jet of zero derivatives in them. Every pass's jets have jet_size_ variables,
@@ -200,6 +211,10 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   struct Equations;  // the shooting equations as a NewtonSolver system
   template <int N>
   void solve(const double* q0, double h, Target target, const double* data);
+  // The step's solve on the shot's adjoint (adjoint_): false where simplified Newton does not
+  // contract (the caller then solves with the exact Jacobian from the same guess).
+  struct AdjointEquations;
+  bool solve_by_adjoint(const double* q0, double h, const double* p0);
   template <int N>
   void warm_start(bool continues);
   template <int N>
@@ -241,6 +256,14 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   // no end corrections, one pass) and the plugin takes the plan: one call a shot.
   ShotPlan shot_plan_;
   bool plugin_shoots_ = false;
+  // The step's shot at doubles with its first derivatives by a reverse sweep, where the exact
+  // Jacobian would take several passes of jets and the shot is an explicit recurrence (an explicit
+  // method, R^n, a Type I form, a constant mass matrix, no forces or end corrections):
+  // shot_adjoint.hpp; null otherwise.
+  std::unique_ptr<ShotAdjoint> adjoint_;
+  NewtonSolver adjoint_solver_;
+  const NewtonSolver* last_solver_ = &solver_;
+  Eigen::VectorXd adjoint_guess_, adjoint_scratch_;
   // Workspace, sized once: a step allocates nothing.
   std::vector<Jet2> state_, next_, acceleration_, gradient_, boundary_, force_;
   std::vector<Jet2> origin_;  // q0 + eta: the origin of the state's positions on a vector space

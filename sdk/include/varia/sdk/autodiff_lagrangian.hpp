@@ -17,7 +17,9 @@
 // (termwise_lagrangian.hpp): linear cost and a sparse Hessian. The same model at dual numbers over
 // second-order jets (kJetDirections directions at a time) gives gradient_jet at any size; forward
 // over forward mode at jet values (jet_tangent.hpp) gives hessian_jet at jets of up to 6 variables
-// and any size, which shooting's lagrangian form needs for a configuration-dependent mass matrix.
+// and any size, which shooting's lagrangian form needs for a configuration-dependent mass matrix;
+// at constants above the stack size hessian_jet forms the products alone, a Hessian-vector product
+// in (m + n) / 8 passes (ChunkProductDual), which shooting's step on the shot's adjoint takes.
 // The first-order pass, inlined into one loop, gives the gradients at several points in one call
 // (gradients) and runs the Galerkin explicit form's Stormer-Verlet steps inside the plugin
 // (kernel::StormerVerletSteps).
@@ -462,9 +464,11 @@ class AutodiffLagrangian : public Lagrangian {
     jet.hessian = x.hessian.topLeftCorner(variables, variables);
     return jet;
   }
-  // Constant inputs and directions: the Hessian at their values (evaluate's, at any size) times the
-  // directions' values, as constant jets.
+  // Constant inputs and directions: the Hessian at their values (evaluate's) times the directions'
+  // values, as constant jets; above kStackVariables the products alone (chunked_hessian_products).
   void hessian_at_constants(const Jet2* q, const Jet2* v, const HessianRows& rows) {
+    if constexpr (!kFixed)
+      if (above_stack()) return chunked_hessian_products(q, v, rows);
     const int k = m_ + n_;
     at_constants_.resize(k), hessian_at_constants_.resize(static_cast<std::size_t>(k) * k);
     for (int i = 0; i < k; ++i) at_constants_[i] = at(q, v, m_, i).value;
@@ -477,6 +481,28 @@ class AutodiffLagrangian : public Lagrangian {
         for (int c = 0; c < k; ++c)
           sum += hessian_at_constants_[static_cast<std::size_t>(c) * k + rows.first + r] * rows.U[j * k + c].value;
         rows.out[j * rows.count + r] = Jet2(sum);
+      }
+  }
+
+  // H(rows, :) U at constants by forward over forward mode: the outer level seeded with the unit
+  // vectors of kChunkDirections rows, the inner with the values of one direction, so that the
+  // second derivatives are (H U_d)(row) (ChunkProductDual, fixed sizes). One pass a block of rows
+  // and a direction: a Hessian-vector product costs (m + n) / 8 passes, where the whole Hessian is
+  // ((m + n) / 8)^2 / 2 passes at the chunks' 8 x 8 second-order numbers (bench/README.md).
+  void chunked_hessian_products(const Jet2* q, const Jet2* v, const HessianRows& rows) {
+    const int k = m_ + n_;
+    product_q_.resize(m_), product_v_.resize(n_);
+    for (int d = 0; d < rows.directions; ++d)
+      for (int a = 0; a < rows.count; a += kChunkDirections) {
+        for (int i = 0; i < k; ++i) {
+          ChunkProductDual& x = input(product_q_, product_v_, i);
+          x.value() = FixedDual<1>(at(q, v, m_, i).value, Eigen::Matrix<double, 1, 1>(rows.U[d * k + i].value));
+          for (int j = 0; j < kChunkDirections; ++j)
+            x.derivatives()(j) = FixedDual<1>(i == rows.first + a + j ? 1.0 : 0.0, Eigen::Matrix<double, 1, 1>(0.0));
+        }
+        const ChunkProductDual r = model().lagrangian(product_q_, product_v_);
+        for (int j = 0; j < kChunkDirections && a + j < rows.count; ++j)
+          rows.out[d * rows.count + a + j] = Jet2(r.derivatives()(j).derivatives()(0));
       }
   }
 
@@ -540,6 +566,7 @@ class AutodiffLagrangian : public Lagrangian {
   Vec<ChunkJetDual> jet_q_, jet_v_;
   Vec<ChunkDual> chunk_q_, chunk_v_;
   Vec<ChunkDual2> chunk2_q_, chunk2_v_;
+  Vec<ChunkProductDual> product_q_, product_v_;
   Vec<ChunkHessianJetDual> hessian_jet_q_, hessian_jet_v_;
   std::vector<FixedJet<kMaxHessianJetVariables>> hessian_jet_z_;
   std::vector<FixedJet<(kFixedJetVariables > 0 && kFixedJetVariables < kMaxHessianJetVariables ? kFixedJetVariables : 1)>>

@@ -73,6 +73,10 @@ using ChunkHessianJetDual = Eigen::AutoDiffScalar<
 // The large systems' dual numbers: kChunkDirections directions (fewer in the last chunk).
 using ChunkDual = Eigen::AutoDiffScalar<Bounded<double, kChunkDirections>>;
 using ChunkDual2 = Eigen::AutoDiffScalar<Bounded<ChunkDual, kChunkDirections>>;
+// Hessian-vector products of the large systems: kChunkDirections outer directions over one inner
+// direction, fixed sizes (unrolled; the capacity-bounded ChunkDual2 with one inner direction costs
+// as much a pass as with eight).
+using ChunkProductDual = Eigen::AutoDiffScalar<Eigen::Matrix<FixedDual<1>, kChunkDirections, 1>>;
 static_assert(kChunkDirections != kStackVariables, "the chunk duals must be types of their own (see Vec)");
 
 // Whether a Vec of T has the stack capacity kStackVariables: every scalar but the value type and
@@ -87,6 +91,8 @@ template <>
 struct OnStack<ChunkDual2> : std::false_type {};
 template <>
 struct OnStack<ChunkJetDual> : std::false_type {};
+template <>
+struct OnStack<ChunkProductDual> : std::false_type {};
 template <>
 struct OnStack<ChunkHessianJetDual> : std::false_type {};
 
