@@ -299,14 +299,10 @@ bool ShootingDiscreteLagrangian::solve_by_adjoint(const double* q0, double h, co
   AdjointEquations equations{*this, q0, h, p0};
   adjoint_guess_ = w_;
   last_solver_ = &adjoint_solver_;
-  const SolveReport report = adjoint_solver_.solve(equations, statistics_);
-  if (report.outcome == SolveReport::Outcome::not_contracting) {
-    w_ = adjoint_guess_;
-    last_solver_ = &solver_;
-    return false;
-  }
-  require_converged(report, "the shooting equations");
-  return true;
+  if (adjoint_solver_.solve(equations, statistics_).converged()) return true;
+  w_ = adjoint_guess_;
+  last_solver_ = &solver_;
+  return false;
 }
 
 // The warm start: w0 = guess + c, the correction c = w0 - guess of the step extrapolated from the

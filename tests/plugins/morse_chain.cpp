@@ -196,7 +196,8 @@ TEST_CASE("shooting on the 60-DOF morse chain (rk4 + Simpson, lagrangian form, t
 // round-off. At a step long enough that simplified Newton stops contracting, the adjoint path
 // falls back to the exact Jacobian: its residuals then fall quadratically.
 TEST_CASE("shooting on a dense chain of 6 DOF: the step on the shot's adjoint takes the exact Jacobian's steps to "
-          "round-off in the lagrangian and hamiltonian forms, and falls back to it where it does not contract") {
+          "round-off in the lagrangian and hamiltonian forms and with a rule without end nodes, and falls back to it "
+          "where it does not contract") {
   MorseChainParameters p;
   p.particles = 3;
   DenseChainShooting chain(p);
@@ -222,6 +223,12 @@ TEST_CASE("shooting on a dense chain of 6 DOF: the step on the shot's adjoint ta
     REQUIRE(last >= 1);
     CHECK(r[last] <= 10 * r[last - 1] * r[last - 1]);
   }
+  // A rule without nodes at the ends (the midpoint rule: the shot's ends carry zero weight).
+  chain.rule = varia::testing::midpoint_rule();
+  const auto exact = chain.map(varia::ShootingForm::lagrangian, 12);
+  const auto adjoint = chain.map(varia::ShootingForm::lagrangian, 4);
+  const VectorXd a = chain.run(*exact, 0.1, 30), b = chain.run(*adjoint, 0.1, 30);
+  CHECK((a - b).lpNorm<Eigen::Infinity>() <= 1e-13 * (1.0 + a.lpNorm<Eigen::Infinity>()));
 }
 
 // The must-show of issue #39: the chain of 30 particles written as one dense autodiff model,

@@ -80,7 +80,7 @@
 // lambda = D2 L_d), whose residuals one forward and one reverse sweep give (shot_adjoint.hpp): a
 // gradient and a Hessian-vector product of L a stage, at any n. Simplified Newton solves them with
 // the Jacobian of the flow to first order in h (shooting_solve.cpp, AdjointEquations), and where it
-// does not contract the step solves with the exact Jacobian from the passes.
+// does not converge the step solves with the exact Jacobian from the passes.
 //
 // Where the shot is one fixed recurrence (an explicit Runge-Kutta method, the lagrangian form on
 // R^n, a constant mass matrix, no forces, no end corrections: explicit_shot.hpp), the Lagrangian's
@@ -212,7 +212,8 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   template <int N>
   void solve(const double* q0, double h, Target target, const double* data);
   // The step's solve on the shot's adjoint (adjoint_): false where simplified Newton does not
-  // contract (the caller then solves with the exact Jacobian from the same guess).
+  // converge (it stops contracting, or reaches the iteration limit: the caller then solves with the
+  // exact Jacobian from the same guess, which reports a failure of its own).
   struct AdjointEquations;
   bool solve_by_adjoint(const double* q0, double h, const double* p0);
   template <int N>
