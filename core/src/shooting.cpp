@@ -210,6 +210,8 @@ void ShootingDiscreteLagrangian::offer_adjoint() {
                                              form_ == ShootingForm::hamiltonian);
     adjoint_guess_.resize(n_);
     adjoint_scratch_.resize(n_);
+    lambda_guess_.resize(n_);
+    corrections_history_.resize(2 * n_, kCorrections);
   }
 }
 

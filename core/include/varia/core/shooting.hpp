@@ -220,6 +220,8 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   void warm_start(bool continues);
   template <int N>
   void record_correction(double h);
+  template <int N>
+  void add_extrapolation(int first, double* x) const;
   bool type_2() const { return form_ == ShootingForm::type_2; }
   // The boundary quantity is the offset q^n - (q0 + eta): a vector space, Type I forms.
   bool offsets() const { return mechanical_ != nullptr && !type_2(); }
@@ -285,9 +287,10 @@ class ShootingDiscreteLagrangian : public DiscreteLagrangian, public DiscreteHam
   bool continuing_ = false;
   double previous_h_ = 0.0;
   // The warm start (warm_start()): the inverse Legendre transform's guess of w0, and the
-  // corrections w0 - guess of the last steps, newest first (corrections_ of them).
+  // corrections w0 - guess of the last steps, newest first (corrections_ of them); on the shot's
+  // adjoint also lambda's guess and corrections (the history's rows n..2n-1).
   static constexpr int kCorrections = 3;
-  Eigen::VectorXd guess_;
+  Eigen::VectorXd guess_, lambda_guess_;
   Eigen::MatrixXd corrections_history_;
   int corrections_ = 0;
   SmallDenseSolver BwT_solver_, jacobian_solver_;  // of B_w^T and the Jacobian
