@@ -79,26 +79,28 @@ void HolonomicConstraints::values(const double* q, double* g) {
   }
 }
 
-void HolonomicConstraints::evaluate_jacobian(const double* q, double* g) {
-  double* values = jacobian_.valuePtr();
+// Each part's values in G's pattern from `call` (a Status, writing part.jacobian_values), checked
+// and placed into `into` (G's pattern and slots).
+template <class Call>
+void HolonomicConstraints::gather(Eigen::SparseMatrix<double, Eigen::RowMajor>& into, const char* call,
+                                  const char* what, Call&& values_of) {
+  double* values = into.valuePtr();
   for (Part& part : parts_) {
-    check(*part.constraint,
-          part.constraint->evaluate(q, g == nullptr ? nullptr : g + part.first_row, part.jacobian_values.data()),
-          "constraint evaluate");
-    check_finite(*part.constraint, part.jacobian_values.data(), static_cast<int>(part.jacobian_values.size()), "Jacobian");
+    check(*part.constraint, values_of(part), call);
+    check_finite(*part.constraint, part.jacobian_values.data(), static_cast<int>(part.jacobian_values.size()), what);
     for (std::size_t e = 0; e < part.jacobian_slots.size(); ++e) values[part.jacobian_slots[e]] = part.jacobian_values[e];
   }
 }
 
+void HolonomicConstraints::evaluate_jacobian(const double* q, double* g) {
+  gather(jacobian_, "constraint evaluate", "Jacobian", [&](Part& part) {
+    return part.constraint->evaluate(q, g == nullptr ? nullptr : g + part.first_row, part.jacobian_values.data());
+  });
+}
+
 void HolonomicConstraints::evaluate_curvature_derivative(const double* q, const double* v) {
-  double* values = curvature_derivative_.valuePtr();
-  for (Part& part : parts_) {
-    check(*part.constraint, part.constraint->curvature_derivative(q, v, part.jacobian_values.data()),
-          "constraint curvature_derivative");
-    check_finite(*part.constraint, part.jacobian_values.data(), static_cast<int>(part.jacobian_values.size()),
-                 "curvature derivative");
-    for (std::size_t e = 0; e < part.jacobian_slots.size(); ++e) values[part.jacobian_slots[e]] = part.jacobian_values[e];
-  }
+  gather(curvature_derivative_, "constraint curvature_derivative", "curvature derivative",
+         [&](Part& part) { return part.constraint->curvature_derivative(q, v, part.jacobian_values.data()); });
 }
 
 void HolonomicConstraints::evaluate_hessian(const double* q, const double* lambda) {

@@ -26,10 +26,14 @@ ShotAdjoint::ShotAdjoint(LagrangianEvaluator& lagrangian, const Eigen::MatrixXd&
   u_.setZero();  // (u, 0): its tail stays zero
 }
 
-double ShotAdjoint::evaluate(const double* y, double* gradient) {
+void ShotAdjoint::take_point(const double* y) {
   for (int r = 0; r < n_; ++r) q_[r] = q0_[r] + y[r];
   if (cotangent_) v_.noalias() = inverse_mass_ * Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
   else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
+}
+
+double ShotAdjoint::evaluate(const double* y, double* gradient) {
+  take_point(y);
   return lagrangian_.value_and_gradient(q_.data(), v_.data(), gradient);
 }
 
@@ -51,9 +55,7 @@ void ShotAdjoint::transposed_jacobian(const double* y, const double* k, double* 
   const Eigen::Map<const Eigen::VectorXd> kq(k, n_), kw(k + n_, n_);
   if (cotangent_) u_.head(n_) = kw;
   else u_.head(n_).noalias() = inverse_mass_ * kw;
-  for (int r = 0; r < n_; ++r) q_[r] = q0_[r] + y[r];
-  if (cotangent_) v_.noalias() = inverse_mass_ * Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
-  else v_ = Eigen::Map<const Eigen::VectorXd>(y + n_, n_);
+  take_point(y);
   lagrangian_.hessian_product(q_.data(), v_.data(), u_.data(), product_.data());
   Eigen::Map<Eigen::VectorXd> position(out, n_), rest(out + n_, n_);
   position = product_.head(n_);

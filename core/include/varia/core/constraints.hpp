@@ -62,6 +62,9 @@ class HolonomicConstraints {
     std::vector<int> jacobian_slots, hessian_slots;  // where each of its entries goes in the values
     Eigen::VectorXd jacobian_values, hessian_values;
   };
+  template <class Call>
+  void gather(Eigen::SparseMatrix<double, Eigen::RowMajor>& into, const char* call, const char* what, Call&& values_of);
+
   std::vector<Part> parts_;
   int n_, m_ = 0;
   Eigen::SparseMatrix<double, Eigen::RowMajor> jacobian_, curvature_derivative_;

@@ -43,7 +43,9 @@ class ShotAdjoint {
   // The stage point (offsets, w) of interval k, stage j (j = 0: the node), and L's gradient there.
   double* point(int k, int j) { return points_.data() + (static_cast<Eigen::Index>(k) * stages_ + j) * 2 * n_; }
   double* gradient(int k, int j) { return gradients_.data() + (static_cast<Eigen::Index>(k) * stages_ + j) * 2 * n_; }
-  // L and its gradient at the state y (offsets, w): its position q0 + offsets and velocity.
+  // q_ and v_: the position q0 + offsets and the velocity of the state y (offsets, w).
+  void take_point(const double* y);
+  // L and its gradient at the state y.
   double evaluate(const double* y, double* gradient);
   // The field (v, M^{-1} L_q) or (v, L_q) from the state and L's gradient there.
   void field(const double* y, const double* gradient, double* f) const;

@@ -24,19 +24,29 @@
 
 namespace varia::sdk::conformance {
 
+// The dense m x n matrix of the values that write(values) gives in the constraint's Jacobian
+// pattern (G; curvature_derivative's dc/dq).
+template <class Write>
+Eigen::MatrixXd in_jacobian_pattern(Constraint& constraint, int n, Write&& write) {
+  const int *rows = nullptr, *cols = nullptr;
+  const int entries = constraint.jacobian_pattern(&rows, &cols);
+  Eigen::VectorXd values(entries);
+  write(values.data());
+  Eigen::MatrixXd A = Eigen::MatrixXd::Zero(constraint.size(), n);
+  for (int e = 0; e < entries; ++e) A(rows[e], cols[e]) = values(e);
+  return A;
+}
+
 // g and G (dense, m x n) at q; throws PluginFault when a call fails.
 struct ConstraintValues {
   Eigen::VectorXd g;
   Eigen::MatrixXd G;
 };
 inline ConstraintValues constraint_values(Constraint& constraint, const Eigen::VectorXd& q) {
-  const int *rows = nullptr, *cols = nullptr;
-  const int entries = constraint.jacobian_pattern(&rows, &cols);
-  const int m = constraint.size(), n = static_cast<int>(q.size());
-  ConstraintValues c{Eigen::VectorXd(m), Eigen::MatrixXd::Zero(m, n)};
-  Eigen::VectorXd values(entries);
-  check(constraint, constraint.evaluate(q.data(), c.g.data(), values.data()), "evaluate");
-  for (int e = 0; e < entries; ++e) c.G(rows[e], cols[e]) = values(e);
+  ConstraintValues c{Eigen::VectorXd(constraint.size()), {}};
+  c.G = in_jacobian_pattern(constraint, static_cast<int>(q.size()), [&](double* values) {
+    check(constraint, constraint.evaluate(q.data(), c.g.data(), values), "evaluate");
+  });
   return c;
 }
 
@@ -93,11 +103,9 @@ inline Failures check_constraint(Constraint& constraint, int n, std::mt19937& en
         std::max(scale, H.lpNorm<Eigen::Infinity>()), "the weighted Hessian is not the derivative of G^T lambda");
     if (constraint.gives_curvature_derivative()) {
       const Eigen::VectorXd v = random_direction(n, engine);
-      Eigen::VectorXd values(jacobian_entries);
-      check(constraint, constraint.curvature_derivative(q.data(), v.data(), values.data()), "curvature_derivative");
-      constraint.jacobian_pattern(&rows, &cols);
-      Eigen::MatrixXd C = Eigen::MatrixXd::Zero(m, n);
-      for (int e = 0; e < jacobian_entries; ++e) C(rows[e], cols[e]) = values(e);
+      const Eigen::MatrixXd C = in_jacobian_pattern(constraint, n, [&](double* values) {
+        check(constraint, constraint.curvature_derivative(q.data(), v.data(), values), "curvature_derivative");
+      });
       const double curvature = v.dot(H * v);
       expect_taylor(
           failures,
