@@ -63,6 +63,9 @@ double wrap(double x) {
 class Pendulum final : public varia::sdk::AutodiffLagrangian<Pendulum, 1, 1> {
  public:
   static constexpr const char* version = "1.0.0";
+  // The shooting construction's shot compiled with L inlined (docs/writing-plugins.md): SVIRK4's
+  // step in bench_gni.
+  static constexpr bool inline_shot = true;
   static constexpr const char* parameter_schema = R"json({
     "$schema": "http://json-schema.org/draft-07/schema#",
     "type": "object",

@@ -60,6 +60,7 @@ struct Oscillator : sdk::AutodiffLagrangian<Oscillator, 1, 1> {
 };
 
 struct Pendulum : sdk::AutodiffLagrangian<Pendulum, 1, 1> {
+  static constexpr bool inline_shot = true;  // SeparablePendulum's shots with L inlined at each stage
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     using std::cos;
@@ -76,6 +77,7 @@ struct Pendulum : sdk::AutodiffLagrangian<Pendulum, 1, 1> {
 template <int Size = Eigen::Dynamic>
 struct Pendulums : sdk::AutodiffLagrangian<Pendulums<Size>, Size, Size> {
   explicit Pendulums(int n = Size) : sdk::AutodiffLagrangian<Pendulums<Size>, Size, Size>(n, n), n_(n) {}
+  static constexpr bool inline_shot = true;  // the shot kernel's test (tests/core/shooting.cpp)
   template <class T>
   T lagrangian(const sdk::Vec<T>& q, const sdk::Vec<T>& v) const {
     using std::cos;

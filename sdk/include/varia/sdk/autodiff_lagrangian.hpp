@@ -22,7 +22,8 @@
 // in (m + n) / 8 passes (ChunkProductDual), which shooting's step on the shot's adjoint takes.
 // The first-order pass, inlined into one loop, gives the gradients at several points in one call
 // (gradients) and runs the Galerkin explicit form's Stormer-Verlet steps inside the plugin
-// (kernel::StormerVerletSteps).
+// (kernel::StormerVerletSteps); a model that asks for it (inline_shot) runs the shooting
+// construction's shot inside the plugin too (kernel::ExplicitShot, docs/writing-plugins.md).
 #pragma once
 
 #include <Eigen/Core>
@@ -108,9 +109,10 @@ class AutodiffLagrangian : public Lagrangian {
 
   // The kernels (abi/kernels.hpp) with the model inlined: Galerkin's explicit form's
   // Stormer-Verlet steps, for m = n and m + n <= kStackVariables (the dual numbers of
-  // first_order); the shooting construction's shot, for sizes given at compile time, m = n up to
-  // kMaxShotDimension, and explicit methods of up to kMaxShotStages stages (other models take the
-  // core's run of the same recurrences).
+  // first_order); the shooting construction's shot, for a model that asks for it
+  // (`static constexpr bool inline_shot = true;`: it is the largest function the model is compiled
+  // into), sizes given at compile time, m = n up to kMaxShotDimension, and explicit methods of up
+  // to kMaxShotStages stages (other models take the core's run of the same recurrences).
   bool offers(const KernelCall& call) const noexcept final {
     if (kernel::arguments<kernel::StormerVerletSteps>(call) != nullptr) return runs_verlet_steps();
     if (const auto* shot = kernel::arguments<kernel::ExplicitShot>(call); shot != nullptr && shot->plan != nullptr)
@@ -124,7 +126,7 @@ class AutodiffLagrangian : public Lagrangian {
         if constexpr (!kFixed || Positions == Velocities)
           verlet_loop<FirstDual, kShapeM>(verlet->q, verlet->d, verlet->f, verlet->K, verlet->steps);
       } else if (const auto* shot = kernel::arguments<kernel::ExplicitShot>(call)) {
-        if constexpr (kFixed && Positions == Velocities && Velocities <= kMaxShotDimension)
+        if constexpr (inlines_shot())
           fixed_shot<Velocities>(*shot->plan, shot->q0, shot->w0, shot->h, shot->action, shot->offsets);
       }
     });
@@ -196,8 +198,13 @@ class AutodiffLagrangian : public Lagrangian {
   const Model& model() const { return static_cast<const Model&>(*this); }
   bool runs_verlet_steps() const { return m_ == n_ && m_ + n_ <= kStackVariables; }
   bool runs_shot(const ShotPlan& plan) const {
-    return kFixed && Positions == Velocities && Velocities <= kMaxShotDimension && plan.n == n_ &&
-           plan.method.stages <= kMaxShotStages;
+    return inlines_shot() && plan.n == n_ && plan.method.stages <= kMaxShotStages;
+  }
+  // Whether the shot kernel is compiled: the model asks for it (inline_shot) and its sizes allow it.
+  static constexpr bool inlines_shot() {
+    if constexpr (requires { Model::inline_shot; })
+      return Model::inline_shot && kFixed && Positions == Velocities && Velocities <= kMaxShotDimension;
+    return false;
   }
   // Whether the model's L is 1/2 v^T M v - V(q) with M constant, read once from its expression.
   bool has_constant_mass_form() const {
