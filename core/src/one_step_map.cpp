@@ -69,8 +69,9 @@ void OneStepHamiltonianMap::take_step(const double* q0, const double* p0, double
 }
 
 std::string OneStepHamiltonianMap::tangent_map_refusal() const {
-  if (constrained_ != nullptr)
-    return "the one-step construction with constraints projects each step onto them, and has no tangent map";
+  if (constrained_ != nullptr && !constrained_->evaluates_at_jets())
+    return "the one-step construction's tangent map steps jets through the index-1 field and the projection onto "
+           "the constraints, which take quadratic constraints only (Constraint::quadratic)";
   if (!lagrangian_.plugin().evaluates_at_jets())
     return "the one-step construction's tangent map steps jets, and this Lagrangian does not evaluate at jets";
   return {};
@@ -149,6 +150,7 @@ void OneStepHamiltonianMap::take_tangent_step(const double* q0, const double* p0
       for (int r = 0; r < size; ++r) jets0_[r].gradient[j] = column_[r];
     }
     field_->step(method_, h, jets0_.data(), jets1_.data(), tangent_stages_);
+    if (constrained_ != nullptr) constrained_->project(jets1_.data(), jets1_.data() + m_, options_);
     for (int j = 0; j < k; ++j) {
       for (int r = 0; r < size; ++r) column_[r] = jets1_[r].constant() ? 0.0 : jets1_[r].gradient[j];
       image(images + static_cast<std::ptrdiff_t>(first + j) * 2 * n_);

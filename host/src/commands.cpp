@@ -293,11 +293,15 @@ nlohmann::ordered_json tangent_map(Prepared& prepared, const TangentOptions& opt
 }
 
 int command_tangent(const CommonOptions& common, const std::string& scene_file, const TangentOptions& options) {
-  bool on_group = false;
+  std::string not_canonical;  // why M^T J M - J is not the map's symplecticity defect, where it is not
   return point_command(
       common, scene_file, options.json,
       [&](Prepared& prepared) {
-        on_group = !prepared.assembly.manifold->is_vector_space();
+        if (!prepared.assembly.manifold->is_vector_space())  // the canonical form has a term in p there
+          not_canonical = "on a Lie group the charts' coordinates are not canonical";
+        else if (prepared.assembly.holonomic)
+          not_canonical = "with constraints the map is read in the embedding, where it projects onto the "
+                          "constraint's cotangent bundle, and a method's symplecticity is on that bundle";
         return tangent_map(prepared, options);
       },
       [&](const nlohmann::ordered_json& result) {
@@ -311,9 +315,9 @@ int command_tangent(const CommonOptions& common, const std::string& scene_file, 
           fmt::print(results(), "  {:>24.16e}\n", fmt::join(row, " "));
           for (int c = 0; c < d; ++c) M(r, c) = row[c];
         }
-        if (on_group)  // the canonical form in left-trivialized coordinates has a term in p
-          fmt::print(results(), "symplecticity defect: not measured here (on a Lie group the charts' coordinates "
-                                "are not canonical: varia verify measures it)\n");
+        if (!not_canonical.empty())
+          fmt::print(results(), "symplecticity defect: not measured here ({}: varia verify measures it)\n",
+                     not_canonical);
         else
           fmt::print(results(), "symplecticity defect max |M^T J M - J| = {:.3e}\n", symplecticity_residual(M));
       });

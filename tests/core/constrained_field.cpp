@@ -1,6 +1,7 @@
 // The constrained field and its projection (varia/core/constrained_field.hpp) against central
-// differences of their values at doubles: the Jacobian an implicit method's stages take, and the
-// first and second derivatives at jets that the shooting construction's shot carries.
+// differences of their values at doubles: the Jacobian an implicit method's stages take, the
+// first and second derivatives at jets that the shooting construction's shot carries, and the
+// one-step map's tangent map, which steps jets through both.
 #include "varia/core/constrained_field.hpp"
 
 #include <doctest/doctest.h>
@@ -10,6 +11,10 @@
 #include <vector>
 
 #include "core/constraint_fixtures.hpp"
+#include "core/fixtures.hpp"
+#include "core/shooting_fixtures.hpp"
+#include "core/tangent_differences.hpp"
+#include "varia/core/one_step_map.hpp"
 
 using namespace varia;
 using namespace varia::testing;
@@ -142,4 +147,29 @@ TEST_CASE("the projection at jets differentiates the projection at doubles, to s
   CHECK(value_error <= 1e-14);
   CHECK(first_error <= 1e-9);
   CHECK(second_error <= 1e-4);  // second differences carry round-off of about 1e-16 / eps^2 = 1e-6
+}
+
+TEST_CASE("the one-step map's tangent map with a quadratic constraint (the index-1 field and the projection at jets) "
+          "equals differences of its projected steps, under rk4 and the 2-stage Gauss method, and with a constraint "
+          "that is not quadratic it is refused") {
+  FlatSpace space(3);
+  FallingMass mass;
+  UnitSphere sphere;
+  HolonomicConstraints constraints({&sphere}, 3);
+  const Eigen::VectorXd q = (Eigen::VectorXd(3) << std::sin(1.0), 0.0, -std::cos(1.0)).finished();
+  const Eigen::VectorXd p = (Eigen::VectorXd(3) << 0.0, 2.5, 0.0).finished();
+  for (sdk::RungeKutta method : {rk4(), gauss2()}) {
+    OneStepHamiltonianMap map(space, mass, method, SolverOptions{}, &constraints);
+    REQUIRE(map.tangent_map_refusal().empty());
+    const TangentCase t = tangent_and_differences(space, map, q, p, 0.0, 0.05);
+    const double difference = (t.exact - t.differences).cwiseAbs().maxCoeff();
+    MESSAGE("largest difference from the differences ", difference);
+    CHECK(difference <= 1e-9);
+    CHECK((t.exact - Eigen::MatrixXd::Identity(6, 6)).cwiseAbs().maxCoeff() >= 1e-2);
+  }
+  QuarticSphere quartic;
+  HolonomicConstraints not_quadratic({&quartic}, 3);
+  sdk::RungeKutta method = rk4();
+  OneStepHamiltonianMap map(space, mass, method, SolverOptions{}, &not_quadratic);
+  CHECK(map.tangent_map_refusal().find("quadratic constraints only") != std::string::npos);
 }

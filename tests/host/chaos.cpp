@@ -85,6 +85,20 @@ TEST_CASE("megno and lyapunov: the chaotic double pendulum (MEGNO > 8, lambda > 
   CHECK(std::abs(oscillator["megno_final"].get<double>()) < 0.1);
 }
 
+TEST_CASE("tangent and megno with a quadratic constraint under one-step rk4: the projected step's Jacobian in the "
+          "embedding, its symplecticity not measured by tangent (verify measures it on the constraint's bundle)") {
+  const auto outcome = run_varia("tangent scenes/multibody/spherical-pendulum-rod-rk4.json --q0 "
+                                 "0.8414709848078965,0,-0.5403023058681398 --p0 0,2.5,0 --h 0.01 --json");
+  CAPTURE(outcome.err);
+  REQUIRE(outcome.code == 0);
+  const json result = json::parse(outcome.out);
+  REQUIRE(result["jacobian"].size() == 6);
+  const auto human = run_varia("tangent scenes/multibody/spherical-pendulum-rod-rk4.json --q0 "
+                               "0.8414709848078965,0,-0.5403023058681398 --p0 0,2.5,0 --h 0.01");
+  CHECK(contains(human.out, "symplecticity defect: not measured here (with constraints"));
+  CHECK(run_varia("validate scenes/multibody/spherical-pendulum-rod-rk4.json --set '/observe=[\"megno\"]'").code == 0);
+}
+
 TEST_CASE("megno on a construction without a tangent map is refused at /observe, exit 2") {
   const auto outcome = run_varia("validate scenes/multibody/spherical-pendulum-rod-s2.json --set '/observe=[\"megno\"]'");
   CHECK(outcome.code == 2);

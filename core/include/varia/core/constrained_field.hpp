@@ -44,6 +44,8 @@ class ConstrainedField final : public EulerLagrangeField {
   // NumericalFailure otherwise), then v onto G(q) v = 0. At jets for quadratic constraints only.
   void project(double* q, double* v, const SolverOptions& options);
   void project(Jet2* q, Jet2* v, const SolverOptions& options);
+  // Whether the field and the projection evaluate at jets (quadratic constraints).
+  bool evaluates_at_jets() const { return quadratic_; }
   // v onto G(q) v = 0 alone, at a point q on the constraint.
   void project_velocity(const double* q, double* v);
 

@@ -35,7 +35,8 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
                         SolverOptions options, HolonomicConstraints* constraints = nullptr);
   int point_size() const override { return m_; }
   int dim() const override { return n_; }
-  // Empty where the Lagrangian evaluates at jets (on R^n and on a Lie group).
+  // Empty where the Lagrangian evaluates at jets (on R^n and on a Lie group), and with constraints
+  // where they are quadratic.
   std::string tangent_map_refusal() const override;
  protected:
   void take_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1) override;
@@ -44,7 +45,8 @@ class OneStepHamiltonianMap : public DiscreteHamiltonianMap {
   // theorem on its stage equations (Runge-Kutta methods commute with linearization; a Lie group
   // method's exponentials are differentiated as they are). In passes of at most the field's
   // jet_variables() directions. On a Lie group the directions and images are in the natural charts
-  // at g0 and g1 (seed(), image()).
+  // at g0 and g1 (seed(), image()). With constraints the jets are projected as the step is, so the
+  // map differentiated is the projected one (on and off the constraint manifold).
   void take_tangent_step(const double* q0, const double* p0, double t0, double h, double* q1, double* p1, int count,
                          const double* directions, double* images) override;
 
