@@ -81,21 +81,16 @@ TEST_CASE("allocations are counted: resizing a dynamic vector allocates") {
 }
 
 TEST_CASE("one-step rk4 and gauss with a constraint (the index-1 field, then the projection) allocate nothing per step, and implicit methods take quadratic constraints only") {
-  FlatSpace space(3);
-  FallingMass mass;
-  UnitSphere sphere;
-  HolonomicConstraints constraints({&sphere}, 3);
-  const Eigen::VectorXd q = (Eigen::VectorXd(3) << std::sin(1.0), 0.0, -std::cos(1.0)).finished();
-  const Eigen::VectorXd p = (Eigen::VectorXd(3) << 0.0, 2.5, 0.0).finished();
+  SphericalPendulum s;
   for (sdk::RungeKutta method : {rk4(), gauss2()}) {
-    OneStepHamiltonianMap map(space, mass, method, SolverOptions{}, &constraints);
-    CHECK(allocations_of_stepping(map, q, p, 0.01, 50) == 0);
+    OneStepHamiltonianMap map(s.space, s.mass, method, SolverOptions{}, &s.constraints);
+    CHECK(allocations_of_stepping(map, s.q, s.p, 0.01, 50) == 0);
   }
-  sphere.declared_quadratic = false;
-  HolonomicConstraints undeclared({&sphere}, 3);
+  s.sphere.declared_quadratic = false;
+  HolonomicConstraints undeclared({&s.sphere}, 3);
   sdk::RungeKutta explicit_method = rk4(), implicit_method = gauss2();
-  CHECK_NOTHROW(OneStepHamiltonianMap(space, mass, explicit_method, SolverOptions{}, &undeclared));
-  CHECK_THROWS_WITH_AS(OneStepHamiltonianMap(space, mass, implicit_method, SolverOptions{}, &undeclared),
+  CHECK_NOTHROW(OneStepHamiltonianMap(s.space, s.mass, explicit_method, SolverOptions{}, &undeclared));
+  CHECK_THROWS_WITH_AS(OneStepHamiltonianMap(s.space, s.mass, implicit_method, SolverOptions{}, &undeclared),
                        doctest::Contains("explicit Runge-Kutta methods only"), std::invalid_argument);
 }
 

@@ -11,7 +11,6 @@
 #include <vector>
 
 #include "core/constraint_fixtures.hpp"
-#include "core/fixtures.hpp"
 #include "core/shooting_fixtures.hpp"
 #include "core/tangent_differences.hpp"
 #include "varia/core/one_step_map.hpp"
@@ -152,16 +151,11 @@ TEST_CASE("the projection at jets differentiates the projection at doubles, to s
 TEST_CASE("the one-step map's tangent map with a quadratic constraint (the index-1 field and the projection at jets) "
           "equals differences of its projected steps, under rk4 and the 2-stage Gauss method, and with a constraint "
           "that is not quadratic it is refused") {
-  FlatSpace space(3);
-  FallingMass mass;
-  UnitSphere sphere;
-  HolonomicConstraints constraints({&sphere}, 3);
-  const Eigen::VectorXd q = (Eigen::VectorXd(3) << std::sin(1.0), 0.0, -std::cos(1.0)).finished();
-  const Eigen::VectorXd p = (Eigen::VectorXd(3) << 0.0, 2.5, 0.0).finished();
+  SphericalPendulum s;
   for (sdk::RungeKutta method : {rk4(), gauss2()}) {
-    OneStepHamiltonianMap map(space, mass, method, SolverOptions{}, &constraints);
+    OneStepHamiltonianMap map(s.space, s.mass, method, SolverOptions{}, &s.constraints);
     REQUIRE(map.tangent_map_refusal().empty());
-    const TangentCase t = tangent_and_differences(space, map, q, p, 0.0, 0.05);
+    const TangentCase t = tangent_and_differences(s.space, map, s.q, s.p, 0.0, 0.05);
     const double difference = (t.exact - t.differences).cwiseAbs().maxCoeff();
     MESSAGE("largest difference from the differences ", difference);
     CHECK(difference <= 1e-9);
@@ -170,6 +164,6 @@ TEST_CASE("the one-step map's tangent map with a quadratic constraint (the index
   QuarticSphere quartic;
   HolonomicConstraints not_quadratic({&quartic}, 3);
   sdk::RungeKutta method = rk4();
-  OneStepHamiltonianMap map(space, mass, method, SolverOptions{}, &not_quadratic);
+  OneStepHamiltonianMap map(s.space, s.mass, method, SolverOptions{}, &not_quadratic);
   CHECK(map.tangent_map_refusal().find("quadratic constraints only") != std::string::npos);
 }
