@@ -7,6 +7,7 @@
 #include <string>
 #include <utility>
 
+#include <Eigen/LU>
 #include <Eigen/SparseLU>
 
 #include "varia/core/solve/newton.hpp"
@@ -142,14 +143,25 @@ const Eigen::MatrixXd& TangentBasis::at(const double* q) {
   return basis_;
 }
 
+// Below kDenseLimit rows the matrix is copied into a dense one, sized once, and factorized by
+// partial pivoting in place: nothing is allocated, and for the small bordered systems of a pendulum
+// or a short chain it is faster than SparseLU, whose numeric factorization and solve allocate their
+// workspace at every call. Above it, SparseLU keeps the cost of a long chain linear in its length.
 struct FixedPatternMatrix::Factorization {
-  Eigen::SparseLU<Eigen::SparseMatrix<double>> lu;
+  static constexpr int kDenseLimit = 32;
+  bool dense = false;
+  Eigen::MatrixXd dense_matrix;
+  Eigen::PartialPivLU<Eigen::MatrixXd> dense_lu;
+  Eigen::SparseLU<Eigen::SparseMatrix<double>> sparse_lu;
 };
 
 FixedPatternMatrix::FixedPatternMatrix() : lu_(std::make_unique<Factorization>()) {}
 FixedPatternMatrix::~FixedPatternMatrix() = default;
 
-void FixedPatternMatrix::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) { out = lu_->lu.solve(rhs); }
+void FixedPatternMatrix::solve(const Eigen::VectorXd& rhs, Eigen::VectorXd& out) {
+  if (lu_->dense) out = lu_->dense_lu.solve(rhs);
+  else out = lu_->sparse_lu.solve(rhs);
+}
 
 void FixedPatternMatrix::reset(int size) {
   entries_.clear();
@@ -170,17 +182,40 @@ void FixedPatternMatrix::finish() {
     positions_.push_back(static_cast<int>(&matrix_.coeffRef(entry.row(), entry.col()) - matrix_.valuePtr()));
   entries_.clear();
   entries_.shrink_to_fit();
+  const int n = size();
+  lu_->dense = n <= Factorization::kDenseLimit;
+  if (lu_->dense) {
+    lu_->dense_matrix.resize(n, n);
+    lu_->dense_lu = Eigen::PartialPivLU<Eigen::MatrixXd>(n);
+  }
   ready_ = true;
 }
 
 void FixedPatternMatrix::factorize(const char* what) {
+  if (lu_->dense) return factorize_dense(what);
   if (!analyzed_) {
-    lu_->lu.analyzePattern(matrix_);
+    lu_->sparse_lu.analyzePattern(matrix_);
     analyzed_ = true;
   }
-  lu_->lu.factorize(matrix_);
-  if (lu_->lu.info() != Eigen::Success)
-    throw NumericalFailure(std::string(what) + " is singular: " + lu_->lu.lastErrorMessage(), std::nan(""));
+  lu_->sparse_lu.factorize(matrix_);
+  if (lu_->sparse_lu.info() != Eigen::Success)
+    throw NumericalFailure(std::string(what) + " is singular: " + lu_->sparse_lu.lastErrorMessage(), std::nan(""));
+}
+
+// Partial pivoting meets a zero pivot exactly where the matrix is singular in its arithmetic, as
+// SparseLU reports it; a pivot that is not finite means the entries were not.
+void FixedPatternMatrix::factorize_dense(const char* what) {
+  auto& A = lu_->dense_matrix;
+  A.setZero();
+  for (int c = 0; c < matrix_.outerSize(); ++c)
+    for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, c); it; ++it) A(it.row(), c) = it.value();
+  lu_->dense_lu.compute(A);
+  const auto pivots = lu_->dense_lu.matrixLU().diagonal();
+  for (Eigen::Index i = 0; i < pivots.size(); ++i)
+    if (!(std::isfinite(pivots(i)) && pivots(i) != 0.0))
+      throw NumericalFailure(std::string(what) + " is singular: pivot " + std::to_string(i) + " is " +
+                                 std::to_string(pivots(i)),
+                             std::nan(""));
 }
 
 CotangentProjection::CotangentProjection(HolonomicConstraints& constraints,
@@ -212,7 +247,9 @@ void CotangentProjection::correction(const double* q, const double* p, double* c
   rhs_.head(n) = Eigen::Map<const Eigen::VectorXd>(p, n);
   saddle_.solve(rhs_, solution_);
   velocity_ = solution_.head(n);
-  Eigen::Map<Eigen::VectorXd>(correction, n).noalias() = -(constraints_.jacobian().transpose() * solution_.tail(constraints_.size()));
+  Eigen::Map<Eigen::VectorXd> out(correction, n);
+  out.setZero();  // (then -= in place: the negated product would be evaluated into a temporary)
+  out.noalias() -= constraints_.jacobian().transpose() * solution_.tail(constraints_.size());
 }
 
 }  // namespace varia

@@ -94,6 +94,20 @@ TEST_CASE("one-step rk4 and gauss with a constraint (the index-1 field, then the
                        doctest::Contains("explicit Runge-Kutta methods only"), std::invalid_argument);
 }
 
+TEST_CASE("galerkin with a constraint (degree 1 and 2, Lobatto points) allocates nothing per step: the bordered "
+          "Newton system and the momentum's projection are small, factorized by a dense LU sized once") {
+  SphericalPendulum s;
+  auto trapezoid_rule = trapezoid();
+  auto lobatto = lobatto3();
+  for (int degree : {1, 2}) {
+    CAPTURE(degree);
+    GalerkinDiscreteLagrangian map(s.space, s.mass, degree == 1 ? static_cast<Quadrature&>(trapezoid_rule) : lobatto,
+                                   equispaced_control_times(degree), {}, {}, &s.constraints);
+    CHECK(allocations_of_stepping(map, s.q, s.p, 0.01, 50) == 0);
+    CHECK(map.solver_statistics().iterations > 50);
+  }
+}
+
 TEST_CASE("shooting rk4 + simpson with a constraint allocates nothing per step, and takes quadratic constraints only") {
   FlatSpace space(3);
   FallingMass mass;

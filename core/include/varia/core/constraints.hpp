@@ -4,8 +4,8 @@
 //     its Jacobian G (m x n) and the Hessian of sum_i lambda_i g_i (n x n), sparse with fixed
 //     patterns, counted and checked;
 //   - FixedPatternMatrix: a sparse matrix whose entries are named once (slots) and whose values are
-//     written in place at every Newton iteration, factorized by Eigen's SparseLU with the symbolic
-//     analysis done once: the Newton Jacobian of the constrained equations (a construction's own
+//     written in place at every Newton iteration, factorized by a dense LU sized once (small
+//     systems: nothing allocated) or Eigen's SparseLU with the symbolic analysis done once: the Newton Jacobian of the constrained equations (a construction's own
 //     Jacobian bordered by the multipliers' blocks, -G^T and G) and the projection below;
 //   - CotangentProjection: the momenta onto the constraint's cotangent space, p1 = p~ - G(q1)^T mu
 //     with G(q1) M^{-1} p1 = 0 (the hidden constraint, for a constant mass matrix M): the saddle
@@ -88,8 +88,9 @@ class TangentBasis {
 };
 
 // A square sparse matrix of a fixed pattern: entries are named (slot) while it is being set up,
-// then finish() fixes the pattern; values are set by slot, and factorize() runs SparseLU's numeric
-// factorization (the symbolic analysis once).
+// then finish() fixes the pattern; values are set by slot, and factorize() runs a dense LU with
+// partial pivoting (up to 32 rows: sized once, it allocates nothing) or SparseLU's numeric
+// factorization (the symbolic analysis once; it allocates its workspace at every call).
 class FixedPatternMatrix {
  public:
   FixedPatternMatrix();
@@ -109,7 +110,8 @@ class FixedPatternMatrix {
   std::vector<Eigen::Triplet<double>> entries_;
   std::vector<int> positions_;
   Eigen::SparseMatrix<double> matrix_;
-  struct Factorization;  // the sparse LU (constraints.cpp)
+  void factorize_dense(const char* what);
+  struct Factorization;  // the dense or the sparse LU (constraints.cpp)
   std::unique_ptr<Factorization> lu_;
   bool ready_ = false, analyzed_ = false;
 };
