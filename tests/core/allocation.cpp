@@ -14,6 +14,7 @@
 #include "core/shooting_fixtures.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/galerkin_chart.hpp"
+#include "varia/core/galerkin_sphere.hpp"
 #include "varia/core/one_step_map.hpp"
 #include "varia/core/shooting.hpp"
 #include "varia/sdk/groups/so3.hpp"
@@ -106,6 +107,15 @@ TEST_CASE("galerkin with a constraint (degree 1 and 2, Lobatto points) allocates
     CHECK(allocations_of_stepping(map, s.q, s.p, 0.01, 50) == 0);
     CHECK(map.solver_statistics().iterations > 50);
   }
+}
+
+TEST_CASE("galerkin in the natural chart of S2 allocates nothing per step: Newton at jets of 4 variables, the "
+          "momentum's projection") {
+  SphericalPendulum s;
+  auto lobatto = lobatto3();
+  SphereGalerkinMap map(s.mass, lobatto, equispaced_control_times(2), {}, s.constraints);
+  CHECK(allocations_of_stepping(map, s.q, s.p, 0.01, 50) == 0);
+  CHECK(map.solver_statistics().iterations > 50);
 }
 
 TEST_CASE("shooting rk4 + simpson with a constraint allocates nothing per step, and takes quadratic constraints only") {

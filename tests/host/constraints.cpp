@@ -32,8 +32,9 @@ json galerkin_lobatto(int degree) {
   return {{"construction", "galerkin"}, {"degree", degree}, {"quadrature", {{"type", "gauss-lobatto"}, {"points", degree + 1}}}};
 }
 
-json spherical_pendulum(const json& method, double h, long steps) {
-  json document = json::parse(test::read_file(test::kSourceDir / "scenes/multibody/spherical-pendulum-rod-s1.json"));
+// The spherical pendulum's scene (by default the particle on a rod) with `method`, `steps` steps of h.
+json spherical_pendulum(const json& method, double h, long steps, const char* scene = "spherical-pendulum-rod-s1.json") {
+  json document = json::parse(test::read_file(test::kSourceDir / "scenes/multibody" / scene));
   document["method"] = method;
   document["step"] = h;
   document.erase("t_end");
@@ -71,15 +72,17 @@ State6 reference_state(const State6& start, double T) {
 
 // The spherical pendulum on a rod under `method` at four step sizes halving from h0 to T = 1: the
 // largest errors in q and p against the RKF7(8) reference, and the order fitted to them. With
-// `constraints`, those instead of the scene's rod (plugins also from the tests' own directory).
-OrderFit spherical_pendulum_order(const json& method, double h0, const json& constraints = nullptr) {
+// `constraints`, those instead of the scene's rod (plugins also from the tests' own directory); with
+// `scene`, that scene (the same pendulum: pendulum-chain on S2 with mass 1 and rod 1, M = I).
+OrderFit spherical_pendulum_order(const json& method, double h0, const json& constraints = nullptr,
+                                  const char* scene_name = "spherical-pendulum-rod-s1.json") {
   Registry registry{Registry::search_path({VARIA_FAULT_PLUGIN_DIR})};
   const double T = 1.0;
   std::vector<double> hs, errors;
   State6 truth{};
   for (double h = h0; hs.size() < 4; h /= 2) {
     Scene scene;
-    json document = spherical_pendulum(method, h, std::lround(T / h));
+    json document = spherical_pendulum(method, h, std::lround(T / h), scene_name);
     if (!constraints.is_null()) document["system"]["constraints"] = constraints;
     Assembly a = assembled(document, registry, scene);
     if (hs.empty()) {
@@ -106,6 +109,21 @@ TEST_CASE("the spherical pendulum on a rod: Galerkin s = 1, 2, 3 with s + 1 Loba
   for (int s = 1; s <= 3; ++s) {
     CAPTURE(s);
     const OrderFit fit = spherical_pendulum_order(galerkin_lobatto(s), std::array<double, 3>{0.02, 0.05, 0.1}[s - 1]);
+    CHECK(fit.used == 4);
+    CHECK(std::abs(fit.slope - 2 * s) <= 0.25);
+  }
+}
+
+// The same pendulum as pendulum-chain on S2, Galerkin in the sphere's natural chart at q0: no
+// multipliers, the unconstrained order min(2s, the rule's) whatever the control times (its errors are
+// smaller than the rod's: s = 3 starts at h = 0.2, so that the last of four points stays above round-off).
+TEST_CASE("the spherical pendulum on S2 in the natural chart: Galerkin s = 1, 2, 3 with s + 1 Lobatto points has orders 2, 4, 6") {
+  for (int s = 1; s <= 3; ++s) {
+    CAPTURE(s);
+    json method = galerkin_lobatto(s);
+    method["chart"] = "natural";
+    const OrderFit fit = spherical_pendulum_order(method, std::array<double, 3>{0.02, 0.05, 0.2}[s - 1], nullptr,
+                                                  "spherical-pendulum-s2.json");
     CHECK(fit.used == 4);
     CHECK(std::abs(fit.slope - 2 * s) <= 0.25);
   }
@@ -244,10 +262,12 @@ Eigen::VectorXd chain_positions(const Eigen::VectorXd& q, const std::vector<doub
 }  // namespace
 
 // Spec "S2 and products": pendulum-chain on S2 x S2 is the same motion as the composite + rods.
-TEST_CASE("pendulum-chain on S2 x S2 agrees with the double spherical pendulum's reference to 1e-7 at T = 3") {
+TEST_CASE("pendulum-chain on S2 x S2 agrees with the double spherical pendulum's reference to 1e-7 at T = 3 (in the embedding and in the natural chart)") {
+  for (const char* name : {"double-spherical-pendulum-s2.json", "double-spherical-pendulum-s2-natural-chart.json"}) {
+  CAPTURE(name);
   Registry registry{Registry::search_path({})};
   Scene scene;
-  Assembly a = assembled(scene_file("double-spherical-pendulum-s2.json"), registry, scene);
+  Assembly a = assembled(scene_file(name), registry, scene);
   const std::vector<double> lengths{1.0, 0.7};
   const Eigen::VectorXd x0 = chain_positions(a.q0, lengths), v0 = chain_positions(a.v0, lengths);
   State12 start(12);
@@ -258,8 +278,9 @@ TEST_CASE("pendulum-chain on S2 x S2 agrees with the double spherical pendulum's
   const Eigen::VectorXd x = chain_positions(trajectory.q(), lengths);
   double error = 0.0;
   for (int k = 0; k < 6; ++k) error = std::max(error, std::abs(x[k] - truth[k]));
-  MESSAGE("pendulum-chain on S2 x S2, h = 0.01, s = 2, T = 3: max |x - x_ref| = ", error);
+  MESSAGE(std::string(name), ", h = 0.01, s = 2, T = 3: max |x - x_ref| = ", error);
   CHECK(error <= 1e-7);
+  }
 }
 
 // One rod of length 1 and mass 1: S2's equation (|q|^2 - 1)/2 is the rod's, and the Lagrangians are
@@ -301,6 +322,27 @@ TEST_CASE("pendulum-chain on S2 x S2 keeps its vertical angular momentum to 1e-1
           record["constraint_error_max"].get<double>());
   CHECK(relative <= 1e-13);
   CHECK(record["constraint_error_max"].get<double>() <= 1e-12);
+}
+
+// Noether in the natural chart: the chart is SO(3)-equivariant, so rotations about e3 leave L_d
+// invariant; the points stay on the spheres without multipliers.
+TEST_CASE("pendulum-chain on S2 x S2 in the natural chart keeps its vertical angular momentum to 1e-13 over 2e4 steps") {
+  Registry registry{Registry::search_path({})};
+  Scene scene;
+  json document = scene_file("double-spherical-pendulum-s2-natural-chart.json");
+  document.erase("t_end");
+  document["steps"] = 20000;
+  document["observe"] = {"momentum", "constraint", "energy"};
+  const json record = record_of(document, registry);
+  const Assembly a = assembled(document, registry, scene);
+  double J0 = 0.0;
+  a.lagrangian->momentum(a.q0.data(), a.v0.data(), &J0);
+  const double relative = record["momentum_error_max"].get<double>() / std::abs(J0);
+  MESSAGE("natural chart: vertical momentum ", J0, ", relative error over 2e4 steps ", relative, ", constraint ",
+          record["constraint_error_max"].get<double>(), ", energy ", record["energy_error_max"].get<double>());
+  CHECK(relative <= 1e-13);
+  CHECK(record["constraint_error_max"].get<double>() <= 1e-13);
+  CHECK(record["energy_error_max"].get<double>() <= 1e-6);
 }
 
 // Spec: initial.p on S2 is dL/dq' in the ambient form with q . p = 0, and so is every written p.
@@ -364,7 +406,7 @@ TEST_CASE("shooting with constraints in passes: a chain of four rods under rk4 +
   CHECK(error <= 1e-7);
 }
 
-TEST_CASE("S2 is refused where it cannot be served, and a point off the sphere at /initial/q") {
+TEST_CASE("S2 is refused where it cannot be served, the natural chart off S2 and above its jets' size, and a point off the sphere at /initial/q") {
   Registry registry{Registry::search_path({})};
   Scene scene;
   json hamiltonian = scene_file("spherical-pendulum-s2.json");
@@ -375,6 +417,13 @@ TEST_CASE("S2 is refused where it cannot be served, and a point off the sphere a
   json off = scene_file("spherical-pendulum-s2.json");
   off["initial"]["q"] = {0.85, 0, -0.54};
   CHECK_THROWS_WITH_AS(assembled(off, registry, scene), doctest::Contains("/initial/q"), InputError);
+  json natural_on_rod = json::parse(test::read_file(test::kSourceDir / "scenes/multibody/spherical-pendulum-rod-s2.json"));
+  natural_on_rod["method"]["chart"] = "natural";
+  CHECK_THROWS_WITH_AS(assembled(natural_on_rod, registry, scene), doctest::Contains("/method/chart"), InputError);
+  json too_many = scene_file("double-spherical-pendulum-s2-natural-chart.json");
+  too_many["method"]["degree"] = 4;
+  too_many["method"]["quadrature"]["points"] = 5;
+  CHECK_THROWS_WITH_AS(assembled(too_many, registry, scene), doctest::Contains("/method/degree"), InputError);
   json mixed = scene_file("spherical-pendulum-s2.json");
   mixed["system"]["manifold"] = {{"type", "product"}, {"factors", {{{"type", "S2"}}, {{"type", "SO3"}}}}};
   CHECK_THROWS_WITH_AS(assembled(mixed, registry, scene), doctest::Contains("/system/manifold"), InputError);
@@ -466,6 +515,17 @@ TEST_CASE("varia verify holds every predicted property of shooting with constrai
     CAPTURE(outcome.err);
     CHECK(outcome.code == 0);
     CHECK(test::contains(outcome.out, "global_order"));
+  }
+}
+
+TEST_CASE("varia verify holds every predicted property of galerkin in the natural chart of S2 and of S2 x S2") {
+  for (const char* name : {"spherical-pendulum-s2-natural-chart.json", "double-spherical-pendulum-s2-natural-chart.json"}) {
+    const auto outcome = test::run_varia(std::string("verify scenes/multibody/") + name);
+    CAPTURE(outcome.out);
+    CAPTURE(outcome.err);
+    CHECK(outcome.code == 0);
+    CHECK(test::contains(outcome.out, "g_invariant               true"));
+    CHECK(test::contains(outcome.out, "momentum_conserved        true"));
   }
 }
 

@@ -45,7 +45,7 @@ TEST_CASE("each schema violation is one line naming its JSON pointer and what wa
       {"/method/solver", json{{"max_iterations", 0}}, "/method/solver/max_iterations: expected an integer >= 1"},
       {"/method/solver", "cayley", "/method/solver: expected an object ({\"tolerance\""},
       {"/method/construction", "galerkn", "/method/construction: expected one of \"galerkin\""},
-      {"/method/form", "hamiltonian", "/method/form: unknown key 'form'; the keys allowed here are: construction, "},
+      {"/method/form", "hamiltonian", "/method/form: unknown key 'form'; the keys allowed here are: chart, construction, "},
       {"/output", json{{"every", 0}}, "/output/every: expected an integer >= 1"},
       {"/observe", json{"energy", "energy"}, "/observe/1: a repeated item (\"energy\"); expected items that are all"},
       {"/initial/q", json{"a"}, "/initial/q/0: expected a number"},

@@ -12,6 +12,7 @@
 #include "parts.hpp"
 #include "varia/core/galerkin.hpp"
 #include "varia/core/galerkin_chart.hpp"
+#include "varia/core/galerkin_sphere.hpp"
 
 namespace varia::host {
 
@@ -27,6 +28,7 @@ struct GalerkinOptions : MethodOptions {
   std::vector<double> control_times;
   bool control_times_given = false;
   bool reduced = false;
+  bool natural_chart = false;  // "chart": "natural" (S2 and products of S2)
 };
 
 // What a quadrature rule determines of the degree-s interpolant. Its velocity, a polynomial of
@@ -100,7 +102,14 @@ class Galerkin final : public Construction {
             "on a Lie group: solve the reduced (higher-order discrete Euler-Poincare) equations; needs a "
             "Lagrangian invariant under the whole group, for which the step takes them whether asked or not "
             "(the same equations, without position jets)"},
-           {"type", "boolean"}}}},
+           {"type", "boolean"}}},
+         {"chart",
+          {{"description",
+            "on S2 and products of S2: 'natural' interpolates each factor in the sphere's natural chart at q0, "
+            "q(t) = Exp_q0(w(t)) with w(t) in the tangent plane (the curves stay on the sphere, no multipliers; "
+            "2 N s <= 12 unknowns a step for N spheres at degree s); 'embedding' (the default) interpolates in R^3 "
+            "with the multipliers of the sphere's equation (docs/constraints.md)"},
+           {"enum", {"embedding", "natural"}}}}},
         {"quadrature", "degree"});
   }
 
@@ -108,6 +117,7 @@ class Galerkin final : public Construction {
     auto options = std::make_shared<GalerkinOptions>();
     options->degree = method["degree"].get<int>();
     options->reduced = method.value("reduced", false);
+    options->natural_chart = method.value("chart", std::string("embedding")) == "natural";
     options->control_times_given = method.contains("control_times");
     options->control_times = method.contains("control_times")
                                  ? method["control_times"].get<std::vector<double>>()
@@ -126,6 +136,7 @@ class Galerkin final : public Construction {
           "trajectory (no theorem, and the steps then have roots that leave every sane range); use a rule with at "
           "least {} weighted nodes, e.g. {{\"type\": \"gauss-legendre\", \"points\": {}}}",
           scene.quadrature->pointer, o.degree, d.nodes, d.nodes, o.degree, o.degree - 1, o.degree, o.degree));
+    if (o.natural_chart) return build_in_sphere_chart(scene, o, a);
     if (!a.manifold->is_vector_space()) return build_on_group(scene, o, a);
     if (o.reduced)
       throw InputError("/method/reduced: the reduced (Euler-Poincare) form is for Lie groups; " + scene.manifold.type +
@@ -146,6 +157,7 @@ class Galerkin final : public Construction {
     Predictions p;
     p.ld_order = p.global_order = d.order;
     p.orders_are_bounds = true;
+    if (options(scene).natural_chart) return predict_in_sphere_chart(a, d, p);
     if (a.manifold->is_vector_space()) p.self_adjoint = a.quadrature->symmetric();
     p.symplectic = p.energy_bounded = true;
     p.reason = "Galerkin (sec. 2): " + d.how +
@@ -184,7 +196,8 @@ class Galerkin final : public Construction {
   }
 
   std::string describe(const Scene& scene) const override {
-    return describe_parts(scene, fmt::format("galerkin degree {}", options(scene).degree));
+    return describe_parts(scene, fmt::format("galerkin degree {}{}", options(scene).degree,
+                                             options(scene).natural_chart ? " in the natural chart of S2" : ""));
   }
 
  private:
@@ -200,6 +213,55 @@ class Galerkin final : public Construction {
       throw InputError(fmt::format(
           "/method/control_times: expected degree + 1 = {} increasing numbers from 0 to 1; found {}", degree + 1,
           brief(json(times))));
+  }
+
+  // On S2 and products of S2 with "chart": "natural", each factor's interpolant lives in the
+  // sphere's natural chart at q0 (core/galerkin_sphere.hpp); the spheres' equations stay in
+  // a.holonomic for the observables, the initial state's check and verify's bundle, not in the steps.
+  static void build_in_sphere_chart(const Scene& scene, const GalerkinOptions& o, Assembly& a) {
+    const bool spheres = a.embedded && a.holonomic && a.holonomic->size() * 3 == a.manifold->dim();
+    if (!spheres || !scene.constraints.empty())
+      throw InputError(fmt::format("/method/chart: 'natural' is the natural chart of S2 and of products of S2, "
+                                   "without the scene's own constraints; the {} manifold{} takes 'embedding' "
+                                   "(Lie groups always interpolate in their natural chart)",
+                                   scene.manifold.type, scene.constraints.empty() ? "" : " with constraints"));
+    if (!a.forces.empty())
+      throw InputError("/system/forces: the galerkin construction in the natural chart of S2 takes no forces");
+    if (o.reduced) throw InputError("/method/reduced: the reduced (Euler-Poincare) form is for Lie groups");
+    const int spheres_count = a.holonomic->size();
+    if (const int unknowns = SphereGalerkinMap::unknowns(spheres_count, o.degree); unknowns > kMaxJetVariables)
+      throw InputError(fmt::format("/method/degree: in the natural chart of S2 a step has 2 N s unknowns, at most {} "
+                                   "(the variables of the jets that give its Newton Jacobian); {} sphere(s) at degree "
+                                   "{} have {}: take degree <= {}, or 'embedding'",
+                                   kMaxJetVariables, spheres_count, o.degree, unknowns,
+                                   kMaxJetVariables / (2 * spheres_count)));
+    if (a.quadrature->derivative_terms() > 0)
+      throw InputError("/method/quadrature: the natural chart of S2 takes rules without derivative terms");
+    if (!a.lagrangian->evaluates_at_jets())
+      throw InputError(fmt::format("/system/lagrangian: the natural chart of S2 evaluates the Lagrangian at jets "
+                                   "(Lagrangian::gradient_jet), which {} does not",
+                                   scene.lagrangian.type));
+    auto map = std::make_unique<SphereGalerkinMap>(*a.lagrangian, *a.quadrature, o.control_times, scene.solver,
+                                                   *a.holonomic);
+    a.discrete_lagrangian = map.get();
+    a.map = std::move(map);
+  }
+
+  // Galerkin's order theorem (sec. 2) holds in any smooth chart: L_d is the chart's pulled-back
+  // Lagrangian's Galerkin L_d; no multiplier enters, so the order is the unconstrained one, and the
+  // map is variational on T*S2 (symplectic, energy bounded). The chart at q0 is not symmetric in q0
+  // and q1 (no self-adjointness predicted), and SO(3)-equivariant: Exp_{R q0}(R w) = R Exp_{q0}(w),
+  // so L_d is invariant under every rotation that leaves L invariant.
+  static Predictions predict_in_sphere_chart(const Assembly& a, const Determination& d, Predictions& p) {
+    p.ld_order.reset();
+    p.symplectic = p.energy_bounded = true;
+    p.reason = "Galerkin (sec. 2) in the natural chart of S2 at q0: " + d.how +
+               "; variational on T*S2 without multipliers (symplectic, energy bounded); the chart at q0 is not "
+               "symmetric in q0 and q1 (self-adjointness not predicted); G-invariant L_d from the SO(3)-equivariant "
+               "chart; L_d's order not predicted (its local error is the global order's, h^(r+1), only where the "
+               "chart's exact discrete Lagrangian is compared, which the measurement does not do)";
+    apply_shared_theorems(a, true, p);
+    return p;
   }
 
   // On a Lie group the interpolant lives in the natural chart at q0 (core/galerkin_chart.hpp).
