@@ -90,3 +90,42 @@ TEST_CASE("galerkin in the natural chart of S2 keeps the spherical pendulum's ve
   CHECK(energy_error > 0.0);
   CHECK(chart.solver_statistics().mean() <= 4.0);
 }
+
+// L_d's derivatives are the step's momenta: after a step (q0, p0) -> (q1, p1), D1 L_d(q0, q1) = -p0
+// and D2 L_d(q0, q1) = p1 on the tangent planes; and D1, D2 are L_d's derivatives along the sphere
+// (central differences of L_d along geodesics through q0 and q1: a test of the derivatives, not a solve).
+TEST_CASE("galerkin in the natural chart of S2: D1 L_d and D2 L_d are the step's -p0 and p1, and L_d's derivatives") {
+  SphericalPendulum s;
+  auto rule = lobatto4();
+  SphereGalerkinMap chart(s.mass, rule, equispaced_control_times(3), {}, s.constraints);
+  const double h = 0.1;
+  Eigen::VectorXd q1(3), p1(3), D1(3), D2(3);
+  chart.step(s.q.data(), s.p.data(), h, q1.data(), p1.data());
+  double Ld = 0.0;
+  chart.evaluate(s.q.data(), q1.data(), h, &Ld, D1.data(), D2.data());
+  auto tangent = [](const Eigen::VectorXd& q, const Eigen::VectorXd& p) -> Eigen::VectorXd { return p - q.dot(p) * q; };
+  CHECK((tangent(s.q, D1) + tangent(s.q, s.p)).lpNorm<Eigen::Infinity>() <= 1e-12);
+  CHECK((tangent(q1, D2) - tangent(q1, p1)).lpNorm<Eigen::Infinity>() <= 1e-12);
+  const Eigen::Vector3d direction = Eigen::Vector3d(q1).cross(Eigen::Vector3d(0.3, -0.5, 0.8)).normalized();
+  auto Ld_at = [&](double t) {
+    const Eigen::VectorXd q = std::cos(t) * q1 + std::sin(t) * Eigen::VectorXd(direction);
+    double value = 0.0;
+    chart.evaluate(s.q.data(), q.data(), h, &value, nullptr, nullptr);
+    return value;
+  };
+  const double d = 1e-4, difference = (Ld_at(d) - Ld_at(-d)) / (2 * d);
+  CHECK(difference == doctest::Approx(D2.dot(Eigen::VectorXd(direction))).epsilon(1e-7));
+  // D1, which the balance of angular momentum gives without differentiating the chart's base point,
+  // against L_d's differences as q0 moves along the sphere
+  const Eigen::Vector3d direction0 = Eigen::Vector3d(s.q).cross(Eigen::Vector3d(-0.7, 0.2, 0.4)).normalized();
+  auto Ld_from = [&](double t) {
+    const Eigen::VectorXd q = std::cos(t) * s.q + std::sin(t) * Eigen::VectorXd(direction0);
+    double value = 0.0;
+    chart.evaluate(q.data(), q1.data(), h, &value, nullptr, nullptr);
+    return value;
+  };
+  CHECK((Ld_from(d) - Ld_from(-d)) / (2 * d) == doctest::Approx(D1.dot(Eigen::VectorXd(direction0))).epsilon(1e-7));
+  // and a wrong derivative is seen: the test's difference is not the derivative along another direction
+  const Eigen::Vector3d other = Eigen::Vector3d(q1).cross(direction);
+  CHECK(std::abs(difference - D2.dot(Eigen::VectorXd(other))) > 1e-3);
+}
