@@ -12,21 +12,56 @@ namespace varia {
 
 namespace {
 
-// cos(sqrt x), sin(sqrt x) / sqrt x and the latter's derivative in x, smooth through x = 0 (their
-// Taylor series below x = 0.04, where the next terms are below 1e-19): the exponential map's
-// coefficients as functions of x = |w|^2.
-template <class T>
-void exponential_coefficients(const T& x, T& C, T& S, T& dS) {
-  if (value_of(x) < 0.04) {
-    C = 1.0 + x * (-1.0 / 2 + x * (1.0 / 24 + x * (-1.0 / 720 + x * (1.0 / 40320 + x * (-1.0 / 3628800 + x / 479001600.0)))));
-    S = 1.0 + x * (-1.0 / 6 + x * (1.0 / 120 + x * (-1.0 / 5040 + x * (1.0 / 362880 + x * (-1.0 / 39916800 + x / 6227020800.0)))));
-    dS = -1.0 / 6 + x * (2.0 / 120 + x * (-3.0 / 5040 + x * (4.0 / 362880 + x * (-5.0 / 39916800 + x * (6.0 / 6227020800.0)))));
-    return;
+// The exponential map's coefficients as functions of x = |w|^2, smooth through x = 0:
+// C(x) = cos(sqrt x) and S(x) = sin(sqrt x) / sqrt x with S's derivatives S1..S3 in x (C' = -S/2,
+// C'' = -S1/2). Below x = 1 their Taylor series to x^12 (the next terms below 1e-19 of the sums);
+// above, the closed forms, S1 = (C - S) / (2x) and S(m+1) = (-S(m-1)/2 - (2m+1) S(m)) / (2x).
+struct ExponentialCoefficients {
+  double C, S[4];
+};
+
+ExponentialCoefficients exponential_coefficients(double x) {
+  ExponentialCoefficients r{};
+  if (x < 1.0) {
+    constexpr int kTerms = 13;
+    double cosine = 0.0, factorial = 1.0, power = 1.0;  // (2k)!, x^k
+    double a[kTerms];                                    // S's coefficients (-1)^k / (2k+1)!
+    for (int k = 0; k < kTerms; ++k) {
+      if (k > 0) factorial *= (2.0 * k - 1) * (2.0 * k);
+      cosine += (k % 2 == 0 ? 1.0 : -1.0) * power / factorial;
+      a[k] = (k % 2 == 0 ? 1.0 : -1.0) / (factorial * (2.0 * k + 1));
+      power *= x;
+    }
+    r.C = cosine;
+    for (int m = 0; m < 4; ++m) {  // S^(m)(x) = sum_k a_k k!/(k-m)! x^(k-m), by Horner
+      double sum = 0.0;
+      for (int k = kTerms - 1; k >= m; --k) {
+        double falling = 1.0;
+        for (int j = 0; j < m; ++j) falling *= k - j;
+        sum = sum * x + a[k] * falling;
+      }
+      r.S[m] = sum;
+    }
+    return r;
   }
-  const T r = sqrt(x);
-  C = cos(r);
-  S = sin(r) / r;
-  dS = (C - S) / (2.0 * x);
+  const double root = std::sqrt(x);
+  r.C = std::cos(root);
+  r.S[0] = std::sin(root) / root;
+  r.S[1] = (r.C - r.S[0]) / (2 * x);
+  for (int m = 1; m < 3; ++m) r.S[m + 1] = (-r.S[m - 1] / 2 - (2 * m + 1) * r.S[m]) / (2 * x);
+  return r;
+}
+
+// C, S and S1 at x, a double or a jet (each a function of one variable: jet::unary).
+void exponential_coefficients(double x, double& C, double& S, double& dS) {
+  const ExponentialCoefficients r = exponential_coefficients(x);
+  C = r.C, S = r.S[0], dS = r.S[1];
+}
+void exponential_coefficients(const Jet2& x, Jet2& C, Jet2& S, Jet2& dS) {
+  const ExponentialCoefficients r = exponential_coefficients(x.value);
+  C = jet::unary(x, r.C, -r.S[0] / 2, -r.S[1] / 2);
+  S = jet::unary(x, r.S[0], r.S[1], r.S[2]);
+  dS = jet::unary(x, r.S[1], r.S[2], r.S[3]);
 }
 
 // An orthonormal basis (e1, e2) of T_q S2 = q^perp: e1 along a x q, a the coordinate axis least
@@ -89,23 +124,57 @@ struct SphereGalerkinMap::Equations {
   }
 
   // A = h sum_i b_i L(q(c_i h), q'(c_i h)) at jets in all 2 N s unknowns, and the balance's
-  // tau = h sum_i b_i (q_i x L_q + q_i' x L_v) into g.balance_.
+  // tau = h sum_i b_i (q_i x L_q + q_i' x L_v) and its first derivatives into g.balance_value_ and
+  // g.balance_jacobian_. The node's z = (q, q') is a jet of
+  // the chart alone; L's gradient and Hessian at z's value give A's by the chain rule,
+  // A_W += b (J^T grad L), A_WW += b (J^T H J + sum_r (grad L)_r z_r's Hessian), J = dz/dW, and
+  // grad L's first derivatives H J (L is not evaluated at jets: its Hessian at doubles costs less).
   Jet2 action_at_jets() {
-    const int N = g.spheres_count_, D = static_cast<int>(g.unknowns_.size());
-    for (int k = 0; k < D; ++k) g.variables_[k] = Jet2::variable(g.unknowns_.data()[k], D, k);
-    Jet2 action(0.0), L;
-    for (Jet2& b : g.balance_) b = Jet2(0.0);
+    const int N = g.spheres_count_, D = static_cast<int>(g.unknowns_.size()), k = 6 * N;
+    for (int j = 0; j < D; ++j) g.variables_[j] = Jet2::variable(g.unknowns_.data()[j], D, j);
+    Jet2 action(0.0);
+    action.resize(D);
+    action.gradient.setZero();
+    action.hessian.setZero();
+    g.balance_value_.setZero();
+    g.balance_jacobian_.setZero();
     for (int i = 0; i < g.weights_.size(); ++i) {
       for (int a = 0; a < N; ++a) curve_at(i, a);
-      g.lagrangian_.gradient_jet(g.q_.data(), g.v_.data(), &L, g.gradient_.data());
+      for (int r = 0; r < k; ++r) {
+        const Jet2& z = r < 3 * N ? g.q_[r] : g.v_[r - 3 * N];
+        g.node_point_[r] = z.value;
+        if (z.constant()) g.node_jacobian_.row(r).setZero();
+        else g.node_jacobian_.row(r) = z.gradient.transpose();
+      }
       const double w = h * g.weights_[i];
-      add_scaled(action, w, L);
+      action.value += w * g.lagrangian_.hessian(g.node_point_.data(), g.node_point_.data() + 3 * N,
+                                               g.node_gradient_.data(), g.node_hessian_.data());
+      g.node_product_.noalias() = g.node_hessian_ * g.node_jacobian_;
+      action.gradient.noalias() += w * (g.node_jacobian_.transpose() * g.node_gradient_);
+      action.hessian.noalias() += w * (g.node_jacobian_.transpose() * g.node_product_);
+      for (int r = 0; r < k; ++r) {
+        const Jet2& z = r < 3 * N ? g.q_[r] : g.v_[r - 3 * N];
+        if (!z.constant()) action.hessian += (w * g.node_gradient_[r]) * z.hessian;
+      }
       for (int a = 0; a < N; ++a) {
-        add_cross(&g.q_[3 * a], &g.gradient_[3 * a], w, &g.balance_[3 * a]);
-        add_cross(&g.v_[3 * a], &g.gradient_[3 * N + 3 * a], w, &g.balance_[3 * a]);
+        add_balance_terms(w, 3 * a, 3 * a);
+        add_balance_terms(w, 3 * a, 3 * N + 3 * a);
       }
     }
     return action;
+  }
+  // tau's terms w z x (grad L)_z of the rows `at` of z (q_a or q_a'), and their derivatives in W,
+  // d(z x y) = -[y]x dz + [z]x dy, dz = J, dy = H J, into factor a's rows `first` of the balance.
+  void add_balance_terms(double w, int first, int at) {
+    const Eigen::Vector3d z = g.node_point_.segment<3>(at), y = g.node_gradient_.segment<3>(at);
+    g.balance_value_.segment<3>(first) += w * z.cross(y);
+    g.balance_jacobian_.middleRows<3>(first).noalias() +=
+        (w * skew(z)) * g.node_product_.middleRows<3>(at) - (w * skew(y)) * g.node_jacobian_.middleRows<3>(at);
+  }
+  static Eigen::Matrix3d skew(const Eigen::Vector3d& x) {
+    Eigen::Matrix3d m;
+    m << 0, -x[2], x[1], x[2], 0, -x[0], -x[1], x[0], 0;
+    return m;
   }
 
   // Factor a's point and velocity on the curve at node i, as jets in the unknowns, into q_, v_.
@@ -158,9 +227,13 @@ struct SphereGalerkinMap::Equations {
     const double* momentum = p0 + 3 * a;
     double size = 0.0;
     for (int c = 0; c < 3; ++c) {
-      const int i = (c + 1) % 3, j = (c + 2) % 3;
-      m[c] = g.balance_[3 * a + c] + (base[i] * momentum[j] - base[j] * momentum[i]);
-      size = std::max({size, std::abs(g.balance_[3 * a + c].value), std::abs(base[i] * momentum[j] - base[j] * momentum[i])});
+      const int i = (c + 1) % 3, j = (c + 2) % 3, row = 3 * a + c;
+      const double tau = g.balance_value_[row], angular = base[i] * momentum[j] - base[j] * momentum[i];
+      m[c] = Jet2(tau + angular);
+      m[c].resize(D);
+      m[c].gradient = g.balance_jacobian_.row(row).transpose();
+      m[c].hessian.setZero();
+      size = std::max({size, std::abs(tau), std::abs(angular)});
     }
     add_cross(q1, p1, -1.0, m);
     for (int c = 0; c < 3; ++c) g.balance_residual_[3 * a + c] = m[c].value;
@@ -198,8 +271,6 @@ SphereGalerkinMap::SphereGalerkinMap(Lagrangian& lagrangian, Quadrature& quadrat
   if (D > kMaxJetVariables)
     throw std::invalid_argument("Galerkin in the natural chart of S2 takes at most " + std::to_string(kMaxJetVariables) +
                                 " unknowns a step (2 N s), got " + std::to_string(D));
-  if (!lagrangian.evaluates_at_jets())
-    throw std::invalid_argument("Galerkin in the natural chart of S2 needs a Lagrangian that evaluates at jets");
   linearization_ = DenseLinearization(D);
   interior_linearization_ = DenseLinearization(D - 2 * spheres_count_);
   bases_.resize(3, 2 * spheres_count_);
@@ -207,8 +278,13 @@ SphereGalerkinMap::SphereGalerkinMap(Lagrangian& lagrangian, Quadrature& quadrat
   variables_.resize(D);
   q_.resize(3 * spheres_count_);
   v_.resize(3 * spheres_count_);
-  gradient_.resize(6 * spheres_count_);
-  balance_.resize(3 * spheres_count_);
+  node_point_.resize(6 * spheres_count_);
+  node_gradient_.resize(6 * spheres_count_);
+  node_hessian_.resize(6 * spheres_count_, 6 * spheres_count_);
+  node_jacobian_.resize(6 * spheres_count_, D);
+  node_product_.resize(6 * spheres_count_, D);
+  balance_value_.resize(3 * spheres_count_);
+  balance_jacobian_.resize(3 * spheres_count_, D);
   end_point_.resize(3 * spheres_count_);
   end_momentum_.resize(3 * spheres_count_);
   correction_.resize(3 * spheres_count_);

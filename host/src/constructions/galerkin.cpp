@@ -237,10 +237,6 @@ class Galerkin final : public Construction {
                                    kMaxJetVariables / (2 * spheres_count)));
     if (a.quadrature->derivative_terms() > 0)
       throw InputError("/method/quadrature: the natural chart of S2 takes rules without derivative terms");
-    if (!a.lagrangian->evaluates_at_jets())
-      throw InputError(fmt::format("/system/lagrangian: the natural chart of S2 evaluates the Lagrangian at jets "
-                                   "(Lagrangian::gradient_jet), which {} does not",
-                                   scene.lagrangian.type));
     auto map = std::make_unique<SphereGalerkinMap>(*a.lagrangian, *a.quadrature, o.control_times, scene.solver,
                                                    *a.holonomic);
     a.discrete_lagrangian = map.get();

@@ -16,9 +16,9 @@
 // that is, on each factor, q0 x p0 = q1 x p1 - h sum_i b_i (q_i x L_q + q_i' x L_v): the discrete
 // balance of angular momentum, which is D1 L_d without differentiating the chart in its base point.
 // The step's equations in the 2 N s unknowns w^1..w^s: dA/dw^j = 0 (j < s), and that balance in
-// T_{q0}. Their Jacobian is exact: the unknowns are the variables of second-order jets (abi/jet.hpp),
-// the Lagrangian is evaluated at jets (Lagrangian::gradient_jet), and A's Hessian and the balance's
-// first derivatives come with the values; 2 N s <= kMaxJetVariables (the host refuses more).
+// T_{q0}. Their Jacobian is exact: the unknowns are the variables of second-order jets (abi/jet.hpp)
+// through the chart, L's gradient and Hessian at each node complete A's Hessian and the balance's
+// first derivatives by the chain rule; 2 N s <= kMaxJetVariables (the host refuses more).
 // L_d itself (DiscreteLagrangian) solves the internal points' equations with w^s = Log_{q0}(q1), and
 // gives D1 and D2 as covectors orthogonal to q0 and q1.
 #pragma once
@@ -77,8 +77,14 @@ class SphereGalerkinMap final : public DiscreteLagrangian, public DiscreteHamilt
   DenseLinearization linearization_, interior_linearization_;
   // Workspace: the base point's tangent bases (3 x 2N), the unknowns (2N x s), the jets at a node.
   Eigen::MatrixXd bases_, unknowns_;
-  std::vector<Jet2> variables_, q_, v_, gradient_, balance_, end_point_, end_momentum_;
+  std::vector<Jet2> variables_, q_, v_, end_point_, end_momentum_;
   Eigen::VectorXd correction_, no_momentum_, balance_residual_, base_, end_;
+  // A node's z = (q, q'), L's gradient and Hessian there, dz/dW and H dz/dW.
+  Eigen::VectorXd node_point_, node_gradient_;
+  Eigen::MatrixXd node_hessian_, node_jacobian_, node_product_;
+  // tau = h sum_i b_i (q_i x L_q + q_i' x L_v) on each factor (3N) and its derivatives in W (3N x D).
+  Eigen::VectorXd balance_value_;
+  Eigen::MatrixXd balance_jacobian_;
 };
 
 }  // namespace varia
