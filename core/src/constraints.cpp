@@ -185,7 +185,7 @@ void FixedPatternMatrix::finish() {
   const int n = size();
   lu_->dense = n <= Factorization::kDenseLimit;
   if (lu_->dense) {
-    lu_->dense_matrix.resize(n, n);
+    lu_->dense_matrix = Eigen::MatrixXd::Zero(n, n);  // off the pattern it stays zero (the LU works on a copy)
     lu_->dense_lu = Eigen::PartialPivLU<Eigen::MatrixXd>(n);
   }
   ready_ = true;
@@ -206,7 +206,6 @@ void FixedPatternMatrix::factorize(const char* what) {
 // SparseLU reports it; a pivot that is not finite means the entries were not.
 void FixedPatternMatrix::factorize_dense(const char* what) {
   auto& A = lu_->dense_matrix;
-  A.setZero();
   for (int c = 0; c < matrix_.outerSize(); ++c)
     for (Eigen::SparseMatrix<double>::InnerIterator it(matrix_, c); it; ++it) A(it.row(), c) = it.value();
   lu_->dense_lu.compute(A);

@@ -1,6 +1,7 @@
 // The Galerkin construction on products of S2 in the natural chart at q0 (galerkin_sphere.hpp: the
 // chart, L_d, and D1 L_d from the balance of angular momentum).
 #include "varia/core/galerkin_sphere.hpp"
+#include "varia/core/so3.hpp"
 
 #include <Eigen/Geometry>
 #include <algorithm>
@@ -169,12 +170,7 @@ struct SphereGalerkinMap::Equations {
     const Eigen::Vector3d z = g.node_point_.segment<3>(at), y = g.node_gradient_.segment<3>(at);
     g.balance_value_.segment<3>(first) += w * z.cross(y);
     g.balance_jacobian_.middleRows<3>(first).noalias() +=
-        (w * skew(z)) * g.node_product_.middleRows<3>(at) - (w * skew(y)) * g.node_jacobian_.middleRows<3>(at);
-  }
-  static Eigen::Matrix3d skew(const Eigen::Vector3d& x) {
-    Eigen::Matrix3d m;
-    m << 0, -x[2], x[1], x[2], 0, -x[0], -x[1], x[0], 0;
-    return m;
+        (w * so3::hat(z)) * g.node_product_.middleRows<3>(at) - (w * so3::hat(y)) * g.node_jacobian_.middleRows<3>(at);
   }
 
   // Factor a's point and velocity on the curve at node i, as jets in the unknowns, into q_, v_.
@@ -255,7 +251,6 @@ SphereGalerkinMap::SphereGalerkinMap(Lagrangian& lagrangian, Quadrature& quadrat
       basis_(control_times, quadrature),
       weights_(Eigen::Map<const Eigen::VectorXd>(quadrature.weights(), quadrature.size())),
       spheres_count_(spheres.size()),
-      spheres_(spheres),
       projection_(spheres, [&] {
         if (spheres.dim() != 3 * spheres.size())
           throw std::invalid_argument("the natural chart of S2 takes N spheres' equations on R^(3N)");

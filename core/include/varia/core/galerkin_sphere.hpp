@@ -70,7 +70,6 @@ class SphereGalerkinMap final : public DiscreteLagrangian, public DiscreteHamilt
   LagrangeBasis basis_;
   Eigen::VectorXd weights_;
   int spheres_count_;
-  HolonomicConstraints& spheres_;
   CotangentProjection projection_;
   NewtonSolver solver_, interior_solver_;  // the step's; L_d's (the internal points alone)
   SolverStatistics statistics_, interior_statistics_;
